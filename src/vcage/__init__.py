@@ -1,0 +1,3 @@
+"""vcage: verified long-horizon robot manipulation datasets in simulation."""
+
+__version__ = "0.1.0"

@@ -1,0 +1,147 @@
+"""The annotated object catalog: object types, their metadata, and queries over them."""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterable
+from dataclasses import dataclass, field
+
+from vcage.assets.annotations import Annotations, FunctionalPoint, Grasp, Placement
+from vcage.assets.parts import RGBA, PartBuilder
+from vcage.errors import CatalogError
+
+Builder = Callable[[PartBuilder], None]
+
+
+@dataclass(frozen=True)
+class ObjectType:
+    """One kind of object: how to build it and what a planner, skill or critic may know about it.
+
+    ``size`` is the full extent (x, y, z) in metres at scale 1 with the origin at the centre of the
+    resting face. ``colors`` maps variant names to RGBA; the first is the default.
+    ``fixed`` objects are welded to their support (no free joint), e.g. a wall switch plate.
+    """
+
+    name: str
+    category: str
+    description: str
+    size: tuple[float, float, float]
+    mass: float
+    colors: dict[str, RGBA]
+    build: Builder = field(repr=False, compare=False)
+    tags: frozenset[str] = frozenset()
+    scale_range: tuple[float, float] = (0.9, 1.1)
+    annotations: Annotations = Annotations()
+    fixed: bool = False
+
+    def __post_init__(self) -> None:
+        if not self.colors:
+            raise CatalogError(f"object type {self.name!r} needs at least one colour variant")
+        lo, hi = self.scale_range
+        if not 0 < lo <= 1.0 <= hi:
+            raise CatalogError(f"object type {self.name!r}: scale_range {self.scale_range} must contain 1")
+
+    @property
+    def grasps(self) -> tuple[Grasp, ...]:
+        return self.annotations.grasps
+
+    @property
+    def placements(self) -> tuple[Placement, ...]:
+        return self.annotations.placements
+
+    @property
+    def functional_points(self) -> tuple[FunctionalPoint, ...]:
+        return self.annotations.functional_points
+
+    def placement(self, name: str | None = None) -> Placement:
+        return _find(self.placements, name, f"{self.name} placement")
+
+    def functional_point(self, name: str | None = None) -> FunctionalPoint:
+        return _find(self.functional_points, name, f"{self.name} functional point")
+
+    def color(self, variant: str | None = None) -> RGBA:
+        if variant is None:
+            return next(iter(self.colors.values()))
+        try:
+            return self.colors[variant]
+        except KeyError:
+            raise CatalogError(
+                f"{self.name} has no colour {variant!r}; variants: {sorted(self.colors)}"
+            ) from None
+
+    @property
+    def footprint_radius(self) -> float:
+        return 0.5 * (self.size[0] ** 2 + self.size[1] ** 2) ** 0.5
+
+
+def _find(items: Iterable, name: str | None, what: str):  # type: ignore[no-untyped-def]
+    items = tuple(items)
+    if not items:
+        raise CatalogError(f"{what}: none annotated")
+    if name is None:
+        return items[0]
+    for item in items:
+        if item.name == name:
+            return item
+    raise CatalogError(f"unknown {what} {name!r}; valid: {[i.name for i in items]}")
+
+
+class Catalog:
+    """A queryable set of object types; unknown names list the valid ones."""
+
+    def __init__(self) -> None:
+        self._types: dict[str, ObjectType] = {}
+
+    def add(self, obj: ObjectType) -> ObjectType:
+        if obj.name in self._types:
+            raise CatalogError(f"object type {obj.name!r} is already in the catalog")
+        self._types[obj.name] = obj
+        return obj
+
+    def get(self, name: str) -> ObjectType:
+        _load_builtin()
+        try:
+            return self._types[name]
+        except KeyError:
+            raise CatalogError(
+                f"unknown object type {name!r}; valid types: {', '.join(self.names())}"
+            ) from None
+
+    def names(self) -> list[str]:
+        _load_builtin()
+        return sorted(self._types)
+
+    def categories(self) -> list[str]:
+        _load_builtin()
+        return sorted({o.category for o in self._types.values()})
+
+    def by_category(self, category: str) -> list[ObjectType]:
+        found = [o for o in self.all() if o.category == category]
+        if not found:
+            raise CatalogError(f"unknown category {category!r}; valid: {', '.join(self.categories())}")
+        return found
+
+    def by_tag(self, tag: str) -> list[ObjectType]:
+        return [o for o in self.all() if tag in o.tags]
+
+    def all(self) -> list[ObjectType]:
+        _load_builtin()
+        return [self._types[n] for n in sorted(self._types)]
+
+    def __len__(self) -> int:
+        _load_builtin()
+        return len(self._types)
+
+    def __contains__(self, name: object) -> bool:
+        _load_builtin()
+        return name in self._types
+
+
+CATALOG = Catalog()
+_loaded = False
+
+
+def _load_builtin() -> None:
+    global _loaded
+    if not _loaded:
+        _loaded = True
+        from vcage.assets import objects  # noqa: F401  (registers the built-in types)

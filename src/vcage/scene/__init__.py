@@ -1,0 +1,1 @@
+"""Scene specification and composition into a MuJoCo model."""

@@ -1,0 +1,1 @@
+"""Simulation: the robot model, the world (stepping, state), and rendering."""

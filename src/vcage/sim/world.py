@@ -1,0 +1,120 @@
+"""The simulated world: model and data, stepping at a control rate, state save/restore.
+
+Instability (NaN or exploding velocities) raises :class:`SimulationError` at the control step where
+it appears, so an unstable rollout is never recorded.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from vcage.config import SimConfig
+from vcage.errors import SimulationError
+from vcage.sim import gl as _gl  # noqa: F401
+from vcage.sim.robot import Robot
+
+import mujoco  # noqa: E402
+
+STATE_SPEC = mujoco.mjtState.mjSTATE_INTEGRATION
+
+
+@dataclass(frozen=True)
+class ObjectInstance:
+    """A catalog object placed in the world: instance name, catalog type and its root body id."""
+
+    name: str
+    type_name: str
+    body_id: int
+    scale: float
+    color: str
+
+
+class World:
+    """A compiled scene with a robot; the only place ``mj_step`` is called during execution."""
+
+    def __init__(self, model: mujoco.MjModel, objects: dict[str, ObjectInstance],
+                 sim: SimConfig = SimConfig()) -> None:
+        self.model = model
+        self.data = mujoco.MjData(model)
+        self.sim = sim
+        self.objects = objects
+        self.robot = Robot(model)
+        self.substeps = sim.substeps
+        self._root_to_object = np.full(model.nbody, -1, dtype=np.int32)
+        self.object_names = list(objects)
+        for idx, inst in enumerate(objects.values()):
+            self._root_to_object[inst.body_id] = idx
+        self.reset()
+
+    @property
+    def control_dt(self) -> float:
+        return self.substeps * self.model.opt.timestep
+
+    def reset(self) -> None:
+        """Back to the model's ``home`` keyframe (robot at home, objects where composed)."""
+        key = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_KEY, "home")
+        if key >= 0:
+            mujoco.mj_resetDataKeyframe(self.model, self.data, key)
+        else:
+            mujoco.mj_resetData(self.model, self.data)
+        mujoco.mj_forward(self.model, self.data)
+
+    def step(self, ctrl: np.ndarray | None = None) -> None:
+        """Apply ``ctrl`` (if given) and advance one control period; raise if unstable."""
+        if ctrl is not None:
+            self.data.ctrl[:] = ctrl
+        mujoco.mj_step(self.model, self.data, nstep=self.substeps)
+        self.check_stable()
+
+    def settle(self, seconds: float) -> None:
+        """Advance with the current controls for ``seconds`` (e.g. to let objects come to rest)."""
+        for _ in range(max(1, round(seconds / self.control_dt))):
+            self.step()
+
+    def check_stable(self) -> None:
+        d = self.data
+        speed = np.max(np.abs(d.qvel)) if d.qvel.size else 0.0
+        if not (np.isfinite(speed) and np.all(np.isfinite(d.qpos))) or speed > self.sim.max_qvel:
+            dof = int(np.nanargmax(np.where(np.isfinite(d.qvel), np.abs(d.qvel), np.inf)))
+            joint = self.model.joint(int(self.model.dof_jntid[dof])).name or f"dof {dof}"
+            raise SimulationError(
+                f"simulation unstable at t={d.time:.3f}s: joint {joint!r} velocity "
+                f"{d.qvel[dof]:.3g} (limit {self.sim.max_qvel}); reduce the timestep or check "
+                "the scene for interpenetrating objects"
+            )
+
+    # -- state -------------------------------------------------------------------------------
+    def get_state(self) -> np.ndarray:
+        """The full integration state (time, qpos, qvel, act, ctrl, ...) for exact replay."""
+        state = np.empty(mujoco.mj_stateSize(self.model, STATE_SPEC))
+        mujoco.mj_getState(self.model, self.data, state, STATE_SPEC)
+        return state
+
+    def set_state(self, state: np.ndarray) -> None:
+        mujoco.mj_setState(self.model, self.data, np.asarray(state, dtype=float), STATE_SPEC)
+        mujoco.mj_forward(self.model, self.data)
+
+    # -- object queries ----------------------------------------------------------------------
+    def object(self, name: str) -> ObjectInstance:
+        try:
+            return self.objects[name]
+        except KeyError:
+            from vcage.errors import SceneError
+
+            raise SceneError(f"no object {name!r} in the scene; objects: {sorted(self.objects)}") from None
+
+    def object_pos(self, name: str) -> np.ndarray:
+        return self.data.xpos[self.object(name).body_id].copy()
+
+    def object_mat(self, name: str) -> np.ndarray:
+        return self.data.xmat[self.object(name).body_id].reshape(3, 3).copy()
+
+    def object_of_geom(self, geom_ids: np.ndarray) -> np.ndarray:
+        """Index into :attr:`object_names` of each geom's object, or -1 for non-objects."""
+        roots = self.model.body_rootid[self.model.geom_bodyid[geom_ids]]
+        return self._root_to_object[roots]
+
+    def joint_value(self, name: str) -> float:
+        return float(self.data.joint(name).qpos[0])

@@ -1,0 +1,1 @@
+"""Skills: inverse kinematics, motion plans, their execution, and manipulation primitives."""
