@@ -53,13 +53,19 @@ class Renderer:
         return r.render()
 
     def depth(self, camera: str) -> np.ndarray:
+        """Distance along the view axis in metres, from a perspective camera."""
         r = self._check(camera)
+        model = self.world.model
+        if int(model.cam_projection[model.camera(camera).id]) != int(mujoco.mjtProjection.mjPROJ_PERSPECTIVE):
+            # mujoco.Renderer linearises depth assuming a perspective projection.
+            raise ConfigError(f"depth is only available from perspective cameras, not {camera!r}")
         r.enable_depth_rendering()
         try:
             r.update_scene(self.world.data, camera=camera)
-            return r.render().astype(np.float32)
+            depth = r.render()
         finally:
             r.disable_depth_rendering()
+        return depth.astype(np.float32)
 
     def segmentation(self, camera: str) -> np.ndarray:
         """Per-pixel object index into ``world.object_names`` (-1: not a catalog object)."""

@@ -18,6 +18,8 @@ from vcage.sim.robot import Robot
 import mujoco  # noqa: E402
 
 STATE_SPEC = mujoco.mjtState.mjSTATE_INTEGRATION
+_BAD_STATE = (int(mujoco.mjtWarning.mjWARN_BADQPOS), int(mujoco.mjtWarning.mjWARN_BADQVEL),
+              int(mujoco.mjtWarning.mjWARN_BADQACC))
 
 
 @dataclass(frozen=True)
@@ -65,8 +67,19 @@ class World:
         """Apply ``ctrl`` (if given) and advance one control period; raise if unstable."""
         if ctrl is not None:
             self.data.ctrl[:] = ctrl
+        before = self._bad_state_warnings()
         mujoco.mj_step(self.model, self.data, nstep=self.substeps)
+        if self._bad_state_warnings() > before:  # MuJoCo reset the data after NaN/Inf/huge values
+            raise SimulationError(
+                f"simulation unstable near t={self.data.time:.3f}s: MuJoCo found NaN, Inf or huge "
+                "values in the state and reset it; reduce the timestep or check the scene for "
+                "interpenetrating objects"
+            )
         self.check_stable()
+
+    def _bad_state_warnings(self) -> int:
+        w = self.data.warning
+        return sum(int(w[i].number) for i in _BAD_STATE)
 
     def settle(self, seconds: float) -> None:
         """Advance with the current controls for ``seconds`` (e.g. to let objects come to rest)."""
@@ -115,6 +128,11 @@ class World:
         """Index into :attr:`object_names` of each geom's object, or -1 for non-objects."""
         roots = self.model.body_rootid[self.model.geom_bodyid[geom_ids]]
         return self._root_to_object[roots]
+
+    def table_top(self) -> float:
+        """Height of the table's top surface."""
+        geom = self.model.geom("table/top")
+        return float(self.data.geom_xpos[geom.id][2] + geom.size[2])
 
     def joint_value(self, name: str) -> float:
         return float(self.data.joint(name).qpos[0])

@@ -47,11 +47,6 @@ class GraspChoice:
     yaw: float  # TCP heading
 
 
-def table_top(world: World) -> float:
-    geom = world.model.geom("table/top")
-    return float(world.data.geom_xpos[geom.id][2] + geom.size[2])
-
-
 class Skills:
     """Plans primitives on a world and executes them with one :class:`Executor`."""
 
@@ -59,7 +54,7 @@ class Skills:
         self.world = world
         self.ik = IKSolver(ROBOT_MOUNT)
         self.executor = executor or Executor(world)
-        self.table_z = table_top(world)
+        self.table_z = world.table_top()
         self._cursor: tuple[np.ndarray, float] | None = None
 
     # -- state of the plan being built ---------------------------------------------------------

@@ -1,0 +1,70 @@
+"""Scripted-expert success rate per atomic task over N seeds, randomisation off and on.
+
+    .venv/bin/python benchmarks/expert_success.py --seeds 50 --workers 2
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+from concurrent.futures import ProcessPoolExecutor
+
+from vcage.config import Randomization
+from vcage.errors import SimulationError
+from vcage.tasks.base import TASKS
+from vcage.tasks.runner import make_task, run_episode
+
+
+def _one(args: tuple[str, int, bool]) -> tuple[str, bool, int, bool, str]:
+    task, seed, randomized = args
+    rand = Randomization() if randomized else Randomization.off()
+    try:
+        res = run_episode(task, seed, rand, record=False)
+        reason = res.skill_error or ("" if res.success else "predicates: " + ",".join(
+            k for k, v in res.info.items() if v is False))
+        return task, randomized, seed, res.success, reason
+    except SimulationError as exc:
+        return task, randomized, seed, False, f"unstable: {exc}"
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__)
+    parser.add_argument("--seeds", type=int, default=50)
+    parser.add_argument("--workers", type=int, default=2)
+    parser.add_argument("--tasks", nargs="*", default=None)
+    args = parser.parse_args()
+    make_task("stack_blocks_two")
+    tasks = args.tasks or TASKS.names()
+    jobs = [(t, s, r) for t in tasks for r in (False, True) for s in range(args.seeds)]
+    t0 = time.perf_counter()
+    with ProcessPoolExecutor(args.workers) as pool:
+        results = list(pool.map(_one, jobs, chunksize=4))
+    wall = time.perf_counter() - t0
+    rates: dict[tuple[str, bool], list[bool]] = {}
+    reasons: dict[str, dict[str, int]] = {}
+    for task, randomized, _seed, ok, reason in results:
+        rates.setdefault((task, randomized), []).append(ok)
+        if not ok:
+            key = reason.split(":")[0][:60]
+            reasons.setdefault(task, {}).setdefault(key, 0)
+            reasons[task][key] += 1
+    print(f"scripted-expert success over {args.seeds} seeds per task ({len(jobs)} episodes, "
+          f"{wall:.0f} s wall on {args.workers} workers)\n")
+    print(f"{'task':28s} {'rand off':>9s} {'rand on':>9s}")
+    means = {False: [], True: []}
+    for task in tasks:
+        off = sum(rates[(task, False)]) / args.seeds
+        on = sum(rates[(task, True)]) / args.seeds
+        means[False].append(off)
+        means[True].append(on)
+        print(f"{task:28s} {off:9.0%} {on:9.0%}")
+    print(f"{'mean':28s} {sum(means[False]) / len(tasks):9.1%} {sum(means[True]) / len(tasks):9.1%}")
+    print(f"{'minimum':28s} {min(means[False]):9.0%} {min(means[True]):9.0%}")
+    if reasons:
+        print("\nfailure reasons (both settings):")
+        for task, counts in sorted(reasons.items()):
+            print(f"  {task}: " + "; ".join(f"{k} x{v}" for k, v in sorted(counts.items())))
+
+
+if __name__ == "__main__":
+    main()

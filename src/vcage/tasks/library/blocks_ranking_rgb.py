@@ -1,0 +1,45 @@
+"""Line up red, green and blue blocks from left to right."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from vcage.skills.primitives import Skills
+from vcage.sim.world import World
+from vcage.tasks import predicates as P
+from vcage.tasks.base import TASKS, AtomicTask, Item
+
+ROW_X = 0.42
+SLOTS_Y = (0.12, 0.0, -0.12)  # left to right as seen from the robot (+y is left)
+
+
+@TASKS.register("blocks_ranking_rgb")
+class BlocksRankingRGB(AtomicTask):
+    instructions = (
+        "arrange the blocks in a row: red, green, blue from left to right",
+        "line up the red, green and blue blocks from left to right",
+        "rank the blocks by colour: red, then green, then blue",
+    )
+
+    def layout(self, rng: np.random.Generator) -> tuple[Item, ...]:
+        # Shuffle which colour starts where, in a back row away from the target row.
+        colors = ["red", "green", "blue"]
+        order = rng.permutation(3)
+        starts = ((0.62, 0.15), (0.64, 0.0), (0.62, -0.15))
+        return tuple(Item(f"block_{colors[i]}", "block", starts[k], colors=(colors[i],))
+                     for k, i in enumerate(order))
+
+    def expert(self, skills: Skills) -> None:
+        for name, y in zip(("block_red", "block_green", "block_blue"), SLOTS_Y, strict=True):
+            skills.do("pick_and_place", obj=name, xy=(ROW_X, y))
+        skills.do("retreat")
+
+    def evaluate(self, world: World) -> dict[str, Any]:
+        order = (P.left_of(world, "block_red", "block_green")
+                 and P.left_of(world, "block_green", "block_blue"))
+        on_table = all(P.on_table(world, b) for b in ("block_red", "block_green", "block_blue"))
+        aligned = np.ptp([world.object_pos(b)[0] for b in ("block_red", "block_green", "block_blue")]) < 0.05
+        return {"success": order and on_table and bool(aligned), "order": order,
+                "on_table": on_table, "aligned": bool(aligned)}

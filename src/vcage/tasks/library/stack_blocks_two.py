@@ -1,0 +1,35 @@
+"""Stack one block on another."""
+
+from __future__ import annotations
+
+from typing import Any
+
+from vcage.skills.primitives import Skills
+from vcage.sim.world import World
+from vcage.tasks import predicates as P
+from vcage.tasks.base import TASKS, AtomicTask, Item
+
+
+@TASKS.register("stack_blocks_two")
+class StackBlocksTwo(AtomicTask):
+    instructions = (
+        "stack the {top} block on the {bottom} block",
+        "put the {top} block on top of the {bottom} one",
+        "place the {top} cube onto the {bottom} cube",
+    )
+    items = (
+        Item("block_a", "block", (0.5, -0.12), colors=("red", "orange", "yellow")),
+        Item("block_b", "block", (0.52, 0.12), colors=("blue", "green", "purple")),
+    )
+
+    def words(self) -> dict[str, str]:
+        return {"top": self.color_of("block_a"), "bottom": self.color_of("block_b")}
+
+    def expert(self, skills: Skills) -> None:
+        skills.do("pick_and_place", obj="block_a", target="block_b")
+        skills.do("retreat")
+
+    def evaluate(self, world: World) -> dict[str, Any]:
+        stacked = P.stacked(world, ["block_b", "block_a"])
+        released = not P.grasped(world, "block_a")
+        return {"success": stacked and released, "stacked": stacked, "released": released}

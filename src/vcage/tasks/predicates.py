@@ -1,0 +1,122 @@
+"""Ground-truth predicates: pure functions of the simulator state of a :class:`World`.
+
+They read positions, orientations, contacts and joint values; they never change the world. The
+image critic must not use them; the oracle and the task ``evaluate`` methods do.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from vcage.assets.catalog import CATALOG
+from vcage.geometry import tilt_of
+from vcage.sim.world import World
+
+XY_TOL = 0.01  # slack beyond a placement region's edge
+Z_TOL = 0.02  # how far above a surface an object may rest and still be "on" it
+
+
+def _region(world: World, target: str, placement: str | None) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
+    """Centre (world), rotation, half size and wall height of ``target``'s placement region."""
+    inst = world.object(target)
+    place = CATALOG.get(inst.type_name).placement(placement)
+    rot = world.object_mat(target)
+    center = world.object_pos(target) + rot @ (np.asarray(place.pos) * inst.scale)
+    return center, rot, np.asarray(place.half_size) * inst.scale, place.wall_height * inst.scale
+
+
+def _in_region(world: World, obj: str, center: np.ndarray, rot: np.ndarray, half: np.ndarray,
+               tol: float = XY_TOL) -> bool:
+    local = rot.T @ (world.object_pos(obj) - center)
+    return bool(np.all(np.abs(local[:2]) <= half + tol))
+
+
+def contact_between(world: World, a: str, b: str) -> bool:
+    """True when any geom of object ``a`` touches any geom of object (or body set) ``b``."""
+    ia, ib = world.object_names.index(a), world.object_names.index(b)
+    d = world.data
+    if d.ncon == 0:
+        return False
+    g1 = world.object_of_geom(d.contact.geom1[: d.ncon])
+    g2 = world.object_of_geom(d.contact.geom2[: d.ncon])
+    return bool(np.any(((g1 == ia) & (g2 == ib)) | ((g1 == ib) & (g2 == ia))))
+
+
+def on(world: World, obj: str, target: str, placement: str | None = None) -> bool:
+    """``obj`` rests on ``target``'s placement surface, within its region."""
+    center, rot, half, _ = _region(world, target, placement)
+    dz = world.object_pos(obj)[2] - center[2]
+    return -0.01 <= dz <= Z_TOL and _in_region(world, obj, center, rot, half)
+
+
+def inside(world: World, obj: str, container: str, placement: str | None = None) -> bool:
+    """``obj``'s origin is within the container's region and below its rim."""
+    center, rot, half, wall = _region(world, container, placement)
+    dz = world.object_pos(obj)[2] - center[2]
+    return -0.01 <= dz <= max(wall, Z_TOL) and _in_region(world, obj, center, rot, half)
+
+
+def on_table(world: World, obj: str, tol: float = 0.01) -> bool:
+    return abs(world.object_pos(obj)[2] - world.table_top()) <= tol
+
+
+def stacked(world: World, objs: list[str]) -> bool:
+    """``objs[0]`` is the bottom; each next one rests on the previous one."""
+    return all(on(world, upper, lower) for lower, upper in zip(objs, objs[1:], strict=False))
+
+
+def near(world: World, a: str, b: str, distance: float = 0.1) -> bool:
+    return bool(np.linalg.norm(world.object_pos(a)[:2] - world.object_pos(b)[:2]) <= distance)
+
+
+def left_of(world: World, a: str, b: str, margin: float = 0.03) -> bool:
+    """``a`` is left of ``b`` as seen from the robot (+y is left), by at least ``margin``."""
+    return bool(world.object_pos(a)[1] >= world.object_pos(b)[1] + margin)
+
+
+def right_of(world: World, a: str, b: str, margin: float = 0.03) -> bool:
+    return bool(world.object_pos(a)[1] <= world.object_pos(b)[1] - margin)
+
+
+def upright(world: World, obj: str, tol: float = 0.2) -> bool:
+    return tilt_of(world.object_mat(obj)) <= tol
+
+
+def lifted(world: World, obj: str, height: float = 0.05) -> bool:
+    return bool(world.object_pos(obj)[2] - world.table_top() >= height)
+
+
+def grasped(world: World, obj: str) -> bool:
+    """Both fingers touch ``obj``."""
+    d, robot = world.data, world.robot
+    idx = world.object_names.index(obj)
+    touching = set()
+    for i in range(d.ncon):
+        g1, g2 = int(d.contact.geom1[i]), int(d.contact.geom2[i])
+        for ga, gb in ((g1, g2), (g2, g1)):
+            body = int(world.model.geom_bodyid[ga])
+            if body in robot.finger_body_ids and world.object_of_geom(np.array([gb]))[0] == idx:
+                touching.add(body)
+    return len(touching) == 2
+
+
+def joint_displacement(world: World, obj: str, joint: str) -> float:
+    """How far ``obj``'s joint has moved from its rest value (absolute, metres or radians)."""
+    jid = world.model.joint(f"{obj}/{joint}").id
+    rest = float(world.model.qpos_spring[world.model.jnt_qposadr[jid]])
+    return abs(float(world.data.qpos[world.model.jnt_qposadr[jid]]) - rest)
+
+
+def pressed(world: World, obj: str, point: str | None = None) -> bool:
+    """The functional point's joint is displaced by at least its annotated travel."""
+    inst = world.object(obj)
+    fp = CATALOG.get(inst.type_name).functional_point(point)
+    if fp.joint is None:
+        return False
+    travel = fp.travel * (inst.scale if fp.kind in ("button",) else 1.0)
+    return joint_displacement(world, obj, fp.joint) >= travel
+
+
+def moved(world: World, obj: str, start_xy: np.ndarray, distance: float) -> bool:
+    return bool(np.linalg.norm(world.object_pos(obj)[:2] - np.asarray(start_xy)[:2]) >= distance)
+

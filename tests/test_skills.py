@@ -1,0 +1,76 @@
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from vcage.errors import IKError, RegistryError, SkillError, UnreachableError
+from vcage.skills.ik import IKSolver, down_rotation
+from vcage.skills.primitives import SKILLS, Skills
+from vcage.sim.robot import HOME_QPOS
+from vcage.sim.world import World
+from vcage.tasks import predicates as P
+
+
+def test_ik_reaches_and_matches_simulated_tcp(world: World) -> None:
+    ik = IKSolver((0.0, 0.0, 0.75))
+    target = np.array([0.5, 0.1, 0.85])
+    q = ik.solve(target, down_rotation(0.3), HOME_QPOS)
+    world.data.qpos[world.robot.arm_qpos] = q
+    import mujoco
+
+    mujoco.mj_forward(world.model, world.data)
+    pos, rot = world.robot.tcp_pose(world.data)
+    np.testing.assert_allclose(pos, target, atol=0.003)
+    np.testing.assert_allclose(rot, down_rotation(0.3), atol=0.03)
+
+
+def test_ik_failures_are_typed() -> None:
+    ik = IKSolver((0.0, 0.0, 0.75))
+    with pytest.raises(UnreachableError, match="reaches"):
+        ik.solve(np.array([1.5, 0.0, 0.8]), down_rotation(0.0), HOME_QPOS)
+    with pytest.raises(IKError):  # inside the sphere but behind/under the base
+        ik.solve(np.array([-0.05, 0.0, 0.45]), down_rotation(0.0), HOME_QPOS)
+
+
+def test_pick_and_place_stacks_and_records(world: World) -> None:
+    skills = Skills(world)
+    plan = SKILLS.get("pick_and_place")(skills, obj="a", target="b")
+    assert plan.duration > 1.0 and all(w.q.shape == (7,) for w in plan.waypoints)
+    skills.executor.run(plan)
+    skills.do("retreat")
+    world.settle(0.3)
+    assert P.stacked(world, ["b", "a"]) and not P.grasped(world, "a")
+    rec = skills.executor.recording.arrays()
+    n = len(skills.executor.recording)
+    assert rec["qpos"].shape == (n, 7) and rec["action"].shape == (n, 8)
+    assert rec["ee_pos"].shape == (n, 3) and rec["ee_quat"].shape == (n, 4)
+    assert [s[0] for s in skills.executor.recording.skills] == ["pick_and_place", "retreat"]
+
+
+def test_grasp_lift_rotate_push_press_primitives(world: World) -> None:
+    skills = Skills(world)
+    skills.do("grasp", obj="a")
+    skills.do("lift", height=0.1)
+    assert P.grasped(world, "a") and P.lifted(world, "a", 0.05)
+    yaw0 = skills.tcp()[1]
+    skills.do("rotate", angle=0.5)
+    assert abs(skills.tcp()[1] - yaw0 - 0.5) < 0.05
+    skills.do("place", obj="a", xy=(0.45, -0.15))
+    skills.do("retreat")
+    world.settle(0.3)
+    assert P.on_table(world, "a") and not P.grasped(world, "a")
+    start = world.object_pos("b")
+    skills.do("push", obj="b", direction=(-1.0, 0.0), distance=0.08)
+    assert P.moved(world, "b", start, 0.04)
+
+
+def test_skill_errors_are_typed(world: World) -> None:
+    skills = Skills(world)
+    with pytest.raises(RegistryError, match="valid names"):
+        skills.do("teleport")
+    with pytest.raises(SkillError, match="no grasp 'handle'"):
+        skills.do("grasp", obj="a", grasp_name="handle")
+    with pytest.raises(SkillError):
+        skills.do("place", obj="a")
+    with pytest.raises(SkillError):
+        skills.do("move_to", pos=np.array([1.6, 0.0, 0.9]))

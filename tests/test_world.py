@@ -1,0 +1,75 @@
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from vcage.errors import ConfigError, SceneError, SimulationError
+from vcage.scene.compose import compose
+from vcage.scene.spec import ObjectSpec, SceneSpec, TableSpec
+from vcage.sim.render import Renderer
+from vcage.sim.robot import HOME_QPOS
+from vcage.sim.world import World
+
+
+def test_home_keyframe_and_objects_rest(world: World) -> None:
+    np.testing.assert_allclose(world.robot.arm_q(world.data), HOME_QPOS)
+    world.settle(0.5)
+    np.testing.assert_allclose(world.robot.arm_q(world.data), HOME_QPOS, atol=0.01)
+    assert abs(world.object_pos("a")[2] - world.table_top()) < 0.002
+
+
+def test_state_restore_replays_exactly(world: World) -> None:
+    ctrl = world.robot.ctrl(HOME_QPOS + 0.2, 0.0)
+    start = world.get_state()
+    for _ in range(20):
+        world.step(ctrl)
+    first = world.data.qpos.copy()
+    world.set_state(start)
+    for _ in range(20):
+        world.step(ctrl)
+    np.testing.assert_array_equal(world.data.qpos, first)
+
+
+def test_instability_is_detected(world: World) -> None:
+    world.data.qvel[world.model.joint("a/free").dofadr[0]] = 1e6
+    with pytest.raises(SimulationError, match="a/free"):
+        world.step()
+    world.reset()
+    world.data.qpos[0] = np.nan
+    with pytest.raises(SimulationError):
+        world.step()
+
+
+def test_table_height_and_unknown_object() -> None:
+    spec = SceneSpec(objects=(ObjectSpec("a", "block", (0.5, 0.0)),), table=TableSpec(height=0.8))
+    world = compose(spec).make_world()
+    assert abs(world.table_top() - 0.8) < 1e-9
+    with pytest.raises(SceneError, match="objects: \\['a'\\]"):
+        world.object("mug")
+    with pytest.raises(SceneError):
+        TableSpec(height=2.0)
+
+
+def test_render_rgb_depth_and_segmentation(world: World) -> None:
+    with Renderer(world, 128, 96) as r:
+        for cam in ("front", "overview", "panda/wrist"):
+            frame = r.frame(cam, depth=True, segmentation=True)
+            assert frame.rgb.shape == (96, 128, 3) and frame.rgb.dtype == np.uint8
+            assert frame.depth is not None and frame.depth.shape == (96, 128)
+            assert np.all(np.isfinite(frame.depth)) and 0.01 < frame.depth.min() < 5.0
+        assert r.rgb("top").shape == (96, 128, 3)
+        with pytest.raises(ConfigError, match="perspective"):
+            r.depth("top")
+        seg = r.segmentation("top")
+        # both blocks are visible from the top and mapped to their object index
+        assert set(np.unique(seg)) == {-1, 0, 1}
+        # block "b" is at +y, i.e. on the image's left half in the top view (+x is up)
+        cols = np.nonzero(seg == world.object_names.index("b"))[1]
+        assert cols.mean() < 64
+        # block "a" lies near the front camera's view axis, about 1.2 m away
+        depth, seg_front = r.depth("front"), r.segmentation("front")
+        cam = world.data.cam_xpos[world.model.camera("front").id]
+        expected = np.linalg.norm(world.object_pos("a") + [0, 0, 0.0225] - cam)
+        assert abs(np.median(depth[seg_front == 0]) - expected) < 0.05
+    with pytest.raises(Exception, match="closed"):
+        r.rgb("top")
