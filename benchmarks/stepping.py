@@ -12,14 +12,13 @@ from __future__ import annotations
 
 import time
 
+import mujoco
 import numpy as np
 
 from vcage.config import Randomization
-from vcage.skills.executor import Executor
 from vcage.sim.robot import HOME_QPOS
+from vcage.skills.executor import Executor
 from vcage.tasks.runner import prepare
-
-import mujoco
 
 CONTROL_STEPS = 2000
 

@@ -31,9 +31,8 @@ def list_tasks() -> None:
     """List the atomic tasks with an example instruction."""
     import numpy as np
 
-    from vcage.tasks.runner import make_task
-
     from vcage.tasks.base import TASKS
+    from vcage.tasks.runner import make_task
 
     make_task("stack_blocks_two")  # loads the library
     table = Table("task", "example instruction")

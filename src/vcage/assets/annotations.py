@@ -7,7 +7,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-Vec3 = tuple[float, float, float]
+Vec3 = tuple[float, ...]  # (x, y, z)
 
 
 @dataclass(frozen=True)

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, field
 
 from vcage.assets.annotations import Annotations, FunctionalPoint, Grasp, Placement
@@ -26,7 +26,7 @@ class ObjectType:
     description: str
     size: tuple[float, float, float]
     mass: float
-    colors: dict[str, RGBA]
+    colors: Mapping[str, RGBA]
     build: Builder = field(repr=False, compare=False)
     tags: frozenset[str] = frozenset()
     scale_range: tuple[float, float] = (0.9, 1.1)

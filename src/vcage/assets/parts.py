@@ -9,15 +9,15 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+from typing import Any
 
+import mujoco
 import numpy as np
 
 from vcage.geometry import mat_to_quat, rot_y, rot_z
-from vcage.sim import gl as _gl  # noqa: F401
 
-import mujoco  # noqa: E402
-
-RGBA = tuple[float, float, float, float]
+RGBA = tuple[float, ...]  # (r, g, b, a)
+VISUAL: dict[str, Any] = {"contype": 0, "conaffinity": 0}  # geom options for decoration only
 
 
 class PartBuilder:
@@ -38,7 +38,7 @@ class PartBuilder:
 
     def _geom(self, gtype: mujoco.mjtGeom, size: Sequence[float], pos: Sequence[float],
               rgba: RGBA | None, name: str | None, quat: Sequence[float] | None,
-              body: mujoco.MjsBody | None, **kw: float) -> mujoco.MjsGeom:
+              body: mujoco.MjsBody | None, **kw: Any) -> mujoco.MjsGeom:
         s = self.scale
         target = body if body is not None else self.body
         geom = target.add_geom(
@@ -57,25 +57,25 @@ class PartBuilder:
 
     def box(self, half: Sequence[float], pos: Sequence[float] = (0, 0, 0), rgba: RGBA | None = None,
             name: str | None = None, quat: Sequence[float] | None = None,
-            body: mujoco.MjsBody | None = None, **kw: float) -> mujoco.MjsGeom:
+            body: mujoco.MjsBody | None = None, **kw: Any) -> mujoco.MjsGeom:
         return self._geom(mujoco.mjtGeom.mjGEOM_BOX, half, pos, rgba, name, quat, body, **kw)
 
     def cylinder(self, radius: float, half_height: float, pos: Sequence[float] = (0, 0, 0),
                  rgba: RGBA | None = None, name: str | None = None,
                  quat: Sequence[float] | None = None, body: mujoco.MjsBody | None = None,
-                 **kw: float) -> mujoco.MjsGeom:
+                 **kw: Any) -> mujoco.MjsGeom:
         return self._geom(mujoco.mjtGeom.mjGEOM_CYLINDER, [radius, half_height], pos, rgba, name,
                           quat, body, **kw)
 
     def sphere(self, radius: float, pos: Sequence[float] = (0, 0, 0), rgba: RGBA | None = None,
                name: str | None = None, body: mujoco.MjsBody | None = None,
-               **kw: float) -> mujoco.MjsGeom:
+               **kw: Any) -> mujoco.MjsGeom:
         return self._geom(mujoco.mjtGeom.mjGEOM_SPHERE, [radius], pos, rgba, name, None, body, **kw)
 
     def capsule(self, radius: float, half_length: float, pos: Sequence[float] = (0, 0, 0),
                 rgba: RGBA | None = None, name: str | None = None,
                 quat: Sequence[float] | None = None, body: mujoco.MjsBody | None = None,
-                **kw: float) -> mujoco.MjsGeom:
+                **kw: Any) -> mujoco.MjsGeom:
         return self._geom(mujoco.mjtGeom.mjGEOM_CAPSULE, [radius, half_length], pos, rgba, name,
                           quat, body, **kw)
 
@@ -108,7 +108,7 @@ class PartBuilder:
 
     def mesh(self, name: str, vertices: np.ndarray, faces: np.ndarray, spec: mujoco.MjSpec,
              pos: Sequence[float] = (0, 0, 0), rgba: RGBA | None = None,
-             body: mujoco.MjsBody | None = None, **kw: float) -> mujoco.MjsGeom:
+             body: mujoco.MjsBody | None = None, **kw: Any) -> mujoco.MjsGeom:
         """A convex mesh geom from vertices and faces (e.g. generated with trimesh)."""
         mesh_name = f"{self.prefix}/{name}_mesh"
         spec.add_mesh(name=mesh_name, uservert=(np.asarray(vertices) * self.scale).flatten().tolist(),

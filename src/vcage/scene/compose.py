@@ -9,6 +9,7 @@ from __future__ import annotations
 from collections import OrderedDict
 from dataclasses import dataclass
 
+import mujoco
 import numpy as np
 
 from vcage.assets.catalog import CATALOG, ObjectType
@@ -16,11 +17,8 @@ from vcage.assets.parts import PartBuilder
 from vcage.config import SimConfig
 from vcage.geometry import look_at_quat, yaw_quat
 from vcage.scene.spec import ROBOT_MOUNT, SceneSpec, TableSpec
-from vcage.sim import gl as _gl  # noqa: F401
 from vcage.sim.robot import GRIPPER_OPEN, HOME_QPOS, Robot, attach_panda
 from vcage.sim.world import ObjectInstance, World
-
-import mujoco  # noqa: E402
 
 TABLE_BODY = "table"
 # Static cameras: name -> (position relative to the table centre at nominal height, target).

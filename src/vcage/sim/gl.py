@@ -1,6 +1,7 @@
 """Choose the offscreen OpenGL backend before MuJoCo is imported.
 
-Import this module before ``mujoco`` wherever rendering may happen. ``MUJOCO_GL`` set by the user
+``vcage/__init__`` calls :func:`choose_gl_backend` before any module imports
+``mujoco``. ``MUJOCO_GL`` set by the user
 wins; otherwise EGL is used when its library is present, then OSMesa.
 """
 
@@ -21,5 +22,3 @@ def choose_gl_backend() -> str:
             return backend
     return os.environ.setdefault("MUJOCO_GL", "egl")
 
-
-GL_BACKEND = choose_gl_backend()

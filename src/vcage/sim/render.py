@@ -7,15 +7,14 @@ them as context managers.
 
 from __future__ import annotations
 
+import contextlib
 from dataclasses import dataclass
 
+import mujoco
 import numpy as np
 
 from vcage.errors import ConfigError
-from vcage.sim import gl as _gl  # noqa: F401
 from vcage.sim.world import World
-
-import mujoco  # noqa: E402
 
 
 @dataclass(frozen=True)
@@ -101,7 +100,5 @@ class Renderer:
         self.close()
 
     def __del__(self) -> None:  # a safety net only; callers close explicitly
-        try:
+        with contextlib.suppress(Exception):  # interpreter shutdown may have torn GL down
             self.close()
-        except Exception:  # noqa: BLE001  (interpreter shutdown)
-            pass

@@ -12,12 +12,10 @@ from dataclasses import dataclass
 from functools import cache
 from pathlib import Path
 
+import mujoco
 import numpy as np
 
 from vcage.geometry import look_at_quat
-from vcage.sim import gl as _gl  # noqa: F401  (sets MUJOCO_GL before mujoco loads)
-
-import mujoco  # noqa: E402
 
 PREFIX = "panda/"  # every robot element is named with this prefix once attached to a scene
 ARM_JOINTS = tuple(f"{PREFIX}robot:panda0_joint{i}" for i in range(1, 8))

@@ -8,14 +8,12 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import mujoco
 import numpy as np
 
 from vcage.config import SimConfig
 from vcage.errors import SimulationError
-from vcage.sim import gl as _gl  # noqa: F401
 from vcage.sim.robot import Robot
-
-import mujoco  # noqa: E402
 
 STATE_SPEC = mujoco.mjtState.mjSTATE_INTEGRATION
 _BAD_STATE = (int(mujoco.mjtWarning.mjWARN_BADQPOS), int(mujoco.mjtWarning.mjWARN_BADQVEL),

@@ -12,8 +12,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from vcage.geometry import mat_to_quat
-from vcage.skills.plan import MotionPlan, min_jerk
 from vcage.sim.world import World
+from vcage.skills.plan import MotionPlan, min_jerk
 
 StepHook = Callable[[World], None]
 

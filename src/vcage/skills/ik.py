@@ -8,15 +8,13 @@ from __future__ import annotations
 
 from functools import cache
 
+import mink
+import mujoco
 import numpy as np
 
 from vcage.errors import IKError, UnreachableError
 from vcage.geometry import rot_x, rot_y, rot_z
-from vcage.sim import gl as _gl  # noqa: F401
 from vcage.sim.robot import HOME_QPOS, TCP_SITE, attach_panda
-
-import mink  # noqa: E402
-import mujoco  # noqa: E402
 
 SHOULDER_HEIGHT = 0.333  # joint 2 above the base
 MAX_REACH = 0.855  # shoulder-to-TCP distance beyond which no configuration exists

@@ -21,11 +21,11 @@ from vcage.errors import IKError, SkillError
 from vcage.geometry import wrap_angle, yaw_of
 from vcage.registry import Registry
 from vcage.scene.spec import ROBOT_MOUNT
+from vcage.sim.robot import HOME_QPOS
+from vcage.sim.world import World
 from vcage.skills.executor import Executor
 from vcage.skills.ik import IKSolver, down_rotation
 from vcage.skills.plan import MotionPlan, Waypoint
-from vcage.sim.robot import HOME_QPOS
-from vcage.sim.world import World
 
 SKILLS: Registry[Callable[..., MotionPlan]] = Registry("skill")
 

@@ -14,8 +14,8 @@ import numpy as np
 from vcage.config import Randomization
 from vcage.registry import Registry
 from vcage.scene.spec import SceneSpec
-from vcage.skills.primitives import Skills
 from vcage.sim.world import World
+from vcage.skills.primitives import Skills
 from vcage.tasks.layout import Item, randomize
 
 __all__ = ["TASKS", "AtomicTask", "Item", "Latch"]

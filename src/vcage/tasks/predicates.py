@@ -16,7 +16,8 @@ XY_TOL = 0.01  # slack beyond a placement region's edge
 Z_TOL = 0.02  # how far above a surface an object may rest and still be "on" it
 
 
-def _region(world: World, target: str, placement: str | None) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
+def _region(world: World, target: str,
+            placement: str | None) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
     """Centre (world), rotation, half size and wall height of ``target``'s placement region."""
     inst = world.object(target)
     place = CATALOG.get(inst.type_name).placement(placement)

@@ -11,9 +11,9 @@ from vcage.config import Randomization, SimConfig
 from vcage.errors import SkillError
 from vcage.scene.compose import compose
 from vcage.scene.spec import SceneSpec
+from vcage.sim.world import World
 from vcage.skills.executor import Recording
 from vcage.skills.primitives import Skills
-from vcage.sim.world import World
 from vcage.tasks.base import TASKS, AtomicTask
 
 SETTLE_SECONDS = 0.3

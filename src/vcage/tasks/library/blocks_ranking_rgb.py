@@ -6,13 +6,14 @@ from typing import Any
 
 import numpy as np
 
-from vcage.skills.primitives import Skills
 from vcage.sim.world import World
+from vcage.skills.primitives import Skills
 from vcage.tasks import predicates as P
 from vcage.tasks.base import TASKS, AtomicTask, Item
 
 ROW_X = 0.42
 SLOTS_Y = (0.12, 0.0, -0.12)  # left to right as seen from the robot (+y is left)
+SLOT_TOL = 0.04  # how close to its slot in the row each block must end
 
 
 @TASKS.register("blocks_ranking_rgb")
@@ -40,6 +41,7 @@ class BlocksRankingRGB(AtomicTask):
         order = (P.left_of(world, "block_red", "block_green")
                  and P.left_of(world, "block_green", "block_blue"))
         on_table = all(P.on_table(world, b) for b in ("block_red", "block_green", "block_blue"))
-        aligned = np.ptp([world.object_pos(b)[0] for b in ("block_red", "block_green", "block_blue")]) < 0.05
-        return {"success": order and on_table and bool(aligned), "order": order,
-                "on_table": on_table, "aligned": bool(aligned)}
+        in_row = all(np.linalg.norm(world.object_pos(b)[:2] - [ROW_X, y]) < SLOT_TOL
+                     for b, y in zip(("block_red", "block_green", "block_blue"), SLOTS_Y, strict=True))
+        return {"success": order and on_table and in_row, "order": order,
+                "on_table": on_table, "in_row": in_row}

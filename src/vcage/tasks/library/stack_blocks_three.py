@@ -4,8 +4,8 @@ from __future__ import annotations
 
 from typing import Any
 
-from vcage.skills.primitives import Skills
 from vcage.sim.world import World
+from vcage.skills.primitives import Skills
 from vcage.tasks import predicates as P
 from vcage.tasks.base import TASKS, AtomicTask, Item
 
