@@ -9,11 +9,15 @@ Rim grasps pinch the wall between the fingers, so their width is the wall thickn
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING
 
 from vcage.assets.annotations import Annotations, Grasp, Placement, StableOrientation
 from vcage.assets.catalog import CATALOG, ObjectType
 from vcage.assets.parts import PartBuilder
 from vcage.geometry import mat_to_quat, rot_y, rot_z
+
+if TYPE_CHECKING:
+    import mujoco
 
 HALF_PI = math.pi / 2
 RIM_DROP = 0.015  # rim grasps hold the wall this far below its top
@@ -21,7 +25,7 @@ INV_SQRT2 = 1 / math.sqrt(2)
 
 
 def _flared_wall(p: PartBuilder, r0: float, r1: float, z0: float, z1: float, thickness: float,
-                 segments: int, name: str = "wall") -> None:
+                 segments: int, name: str = "wall") -> list[mujoco.MjsGeom]:
     """A ring of box walls whose inner surface runs from radius ``r0`` at ``z0`` to ``r1`` at ``z1``.
 
     The walls open outwards (``r1 > r0``), so a second copy of the object nests inside.
@@ -32,11 +36,13 @@ def _flared_wall(p: PartBuilder, r0: float, r1: float, z0: float, z1: float, thi
     normal = (math.cos(tilt), -math.sin(tilt))  # outward normal in the (r, z) plane
     rc = (r0 + r1) / 2 + normal[0] * thickness / 2
     zc = (z0 + z1) / 2 + normal[1] * thickness / 2
+    geoms = []
     for i in range(segments):
         ang = 2 * math.pi * i / segments
         quat = mat_to_quat(rot_z(ang) @ rot_y(tilt)).tolist()
-        p.box([thickness / 2, half_w, length / 2], [rc * math.cos(ang), rc * math.sin(ang), zc],
-              name=f"{name}{i}", quat=quat)
+        geoms.append(p.box([thickness / 2, half_w, length / 2],
+                           [rc * math.cos(ang), rc * math.sin(ang), zc], name=f"{name}{i}", quat=quat))
+    return geoms
 
 
 def _rim_grasps(radius: float, z: float, angles: tuple[float, ...], width: float,
@@ -118,6 +124,7 @@ CATALOG.add(ObjectType(
 
 # --- bowl (flared, nests) -----------------------------------------------------------------------
 BOWL_R0, BOWL_R1, BOWL_H, BOWL_T, BOWL_FLOOR = 0.036, 0.07, 0.055, 0.004, 0.004
+BOWL_FRICTION = 0.15
 _BOWL_TILT = math.atan2(BOWL_R1 - BOWL_R0, BOWL_H - BOWL_FLOOR)
 _BOWL_OUT = BOWL_R1 + BOWL_T * math.cos(_BOWL_TILT)  # outer radius at the rim
 
@@ -127,8 +134,12 @@ def _bowl_inner_r(z: float) -> float:
 
 
 def _bowl(p: PartBuilder) -> None:
-    p.cylinder(BOWL_R0 + BOWL_T, BOWL_FLOOR / 2, [0, 0, BOWL_FLOOR / 2], name="floor")
-    _flared_wall(p, BOWL_R0, BOWL_R1, BOWL_FLOOR, BOWL_H, BOWL_T, segments=16)
+    floor = p.cylinder(BOWL_R0 + BOWL_T, BOWL_FLOOR / 2, [0, 0, BOWL_FLOOR / 2], name="floor")
+    walls = _flared_wall(p, BOWL_R0, BOWL_R1, BOWL_FLOOR, BOWL_H, BOWL_T, segments=16)
+    # Glazed ceramic is slippery on itself: MuJoCo takes the larger friction of a contact pair, so
+    # this only matters bowl-on-bowl, where a bowl put in off-centre slides down and nests level.
+    for geom in (floor, *walls):
+        geom.friction = [BOWL_FRICTION * p.friction, 0.005, 0.0001]
 
 
 _BOWL_GRASP_Z = BOWL_H - 0.008
