@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 
 import numpy as np
 import pytest
@@ -30,7 +31,7 @@ def _world(*objects: ObjectSpec) -> World:
     return compose(SceneSpec(objects=tuple(objects))).make_world()
 
 
-def _in_size_box(otype: ObjectType, pos: tuple[float, float, float], tol: float = 1e-6) -> bool:
+def _in_size_box(otype: ObjectType, pos: Sequence[float], tol: float = 1e-6) -> bool:
     sx, sy, sz = otype.size
     return (abs(pos[0]) <= sx / 2 + tol and abs(pos[1]) <= sy / 2 + tol
             and -tol <= pos[2] <= sz + tol)

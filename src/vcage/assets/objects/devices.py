@@ -130,6 +130,10 @@ STAPLER_OPEN = 0.25  # rad: the arm's front rises this much at rest
 STAPLER_K = 1.5  # N m / rad about the open pose: the arm droops ~0.013 rad under its weight
 
 
+def _vec3(v: np.ndarray) -> tuple[float, float, float]:
+    return round(float(v[0]), 4), round(float(v[1]), 4), round(float(v[2]), 4)
+
+
 def _stapler_point(x: float, z: float, angle: float = -STAPLER_OPEN) -> np.ndarray:
     """A point of the arm (arm frame: x forward from the hinge) in the object frame."""
     return np.asarray(STAPLER_HINGE) + rot_y(angle) @ np.array([x, 0.0, z])
@@ -157,7 +161,7 @@ def _stapler(p: PartBuilder) -> None:
     p.cylinder(0.006, 0.018, [0, 0, 0], METAL, name="hinge_pin", quat=Y_AXIS_QUAT, body=arm)
 
 
-_STAPLER_PRESS = tuple(round(float(v), 4) for v in _stapler_point(STAPLER_ARM_LEN - 0.015, 0.015))
+_STAPLER_PRESS = _vec3(_stapler_point(STAPLER_ARM_LEN - 0.015, 0.015))
 _STAPLER_TOP = float(_stapler_point(STAPLER_ARM_LEN, 0.015)[2])
 CATALOG.add(ObjectType(
     name="stapler", category="device", description="a desk stapler with a spring-loaded arm",
@@ -206,8 +210,8 @@ def _switch(p: PartBuilder) -> None:
           name="mark_on", body=rocker, **VISUAL)
 
 
-_SWITCH_ON = tuple(round(float(v), 4) for v in _switch_point(SWITCH_ROCKER[0] * 0.7))
-_SWITCH_OFF = tuple(round(float(v), 4) for v in _switch_point(-SWITCH_ROCKER[0] * 0.7, SWITCH_THROW))
+_SWITCH_ON = _vec3(_switch_point(SWITCH_ROCKER[0] * 0.7))
+_SWITCH_OFF = _vec3(_switch_point(-SWITCH_ROCKER[0] * 0.7, SWITCH_THROW))
 _SWITCH_TOP = float(_switch_point(SWITCH_ROCKER[0])[2])
 CATALOG.add(ObjectType(
     name="switch", category="device", description="a rocker switch on a small base",

@@ -190,7 +190,7 @@ CATALOG.add(ObjectType(
 ))
 
 # --- bread --------------------------------------------------------------------------------------
-BREAD = (0.16, 0.062, 0.07)  # loaf length, width, height
+BREAD = (0.14, 0.062, 0.068)  # loaf length, width, height: fits a basket at any scale
 
 
 def _bread(p: PartBuilder) -> None:
@@ -199,7 +199,7 @@ def _bread(p: PartBuilder) -> None:
     p.box([lx / 2, ly / 2, (lz - cap_r) / 2], [0, 0, (lz - cap_r) / 2], name="loaf")
     p.capsule(cap_r, lx / 2 - cap_r, [0, 0, lz - cap_r], name="crust", quat=X_AXIS_QUAT)
     score = tuple(0.8 * c for c in p.rgba[:3]) + (1.0,)
-    for i, x in enumerate((-0.04, 0.0, 0.04)):
+    for i, x in enumerate((-0.03, 0.0, 0.03)):
         p.box([0.004, ly * 0.3, 0.001], [x, 0, lz - 0.0005], score, name=f"score{i}",
               quat=mat_to_quat(rot_z(0.5)).tolist(), **VISUAL)
 
@@ -212,7 +212,7 @@ CATALOG.add(ObjectType(
     build=_bread, tags=frozenset({"graspable", "food", "soft"}),
     annotations=Annotations(
         grasps=(*_pair("top", (0, 0, 0.045), BREAD[1], second=math.pi),
-                *_pair("top_end", (0.045, 0, 0.045), BREAD[1], second=math.pi)),
+                *_pair("top_end", (0.035, 0, 0.045), BREAD[1], second=math.pi)),
     ),
 ))
 
