@@ -46,7 +46,9 @@ class FunctionalPoint:
     """A point with a function: a button to press, a switch side to toggle, a stamp face.
 
     ``joint`` names the object's joint that moves when the function is used (relative name), and
-    ``travel`` how far it must move (metres or radians) to count as used.
+    ``travel`` how far it must move (metres or radians) to count as used. ``stroke`` is how far
+    the point itself moves down over one full use (metres, object frame): the press depth a skill
+    needs, whether the joint slides (a button) or turns (a lever, a rocker).
     """
 
     name: str
@@ -54,6 +56,7 @@ class FunctionalPoint:
     pos: Vec3
     joint: str | None = None
     travel: float = 0.0
+    stroke: float = 0.0
     direction: Vec3 = (0.0, 0.0, -1.0)
 
 

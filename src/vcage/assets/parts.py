@@ -80,20 +80,37 @@ class PartBuilder:
                           quat, body, **kw)
 
     def ring(self, radius: float, height: float, thickness: float, segments: int = 12,
-             z0: float = 0.0, flare: float = 0.0, rgba: RGBA | None = None,
-             body: mujoco.MjsBody | None = None, name: str = "wall") -> None:
-        """A ring of box walls from ``z0`` to ``z0 + height`` (hollow cylinder approximation).
-
-        ``flare`` tilts the walls outwards (radians), for bowls and baskets.
-        """
+             z0: float = 0.0, rgba: RGBA | None = None, body: mujoco.MjsBody | None = None,
+             name: str = "wall") -> None:
+        """A ring of upright box walls from ``z0`` to ``z0 + height`` with inner radius ``radius``."""
         seg_len = 2 * radius * math.tan(math.pi / segments) + thickness
+        r = radius + thickness / 2
         for i in range(segments):
             ang = 2 * math.pi * i / segments
-            r = radius + thickness / 2 + math.sin(flare) * height / 2
             pos = [r * math.cos(ang), r * math.sin(ang), z0 + height / 2]
-            rot = mat_to_quat(rot_z(ang) @ rot_y(-flare))
-            self.box([thickness / 2, seg_len / 2, height / 2 / math.cos(flare)], pos, rgba,
-                     name=f"{name}{i}", quat=rot.tolist(), body=body)
+            self.box([thickness / 2, seg_len / 2, height / 2], pos, rgba, name=f"{name}{i}",
+                     quat=mat_to_quat(rot_z(ang)).tolist(), body=body)
+
+    def flared_ring(self, r0: float, r1: float, z0: float, z1: float, thickness: float,
+                    segments: int, name: str = "wall") -> list[mujoco.MjsGeom]:
+        """A ring of box walls whose inner surface runs from radius ``r0`` at ``z0`` to ``r1`` at ``z1``.
+
+        With ``r1 > r0`` the walls open outwards, so a second copy of the object nests inside.
+        """
+        tilt = math.atan2(r1 - r0, z1 - z0)
+        length = math.hypot(r1 - r0, z1 - z0)
+        half_w = (r1 + thickness) * math.tan(math.pi / segments)
+        normal = (math.cos(tilt), -math.sin(tilt))  # outward normal in the (r, z) plane
+        rc = (r0 + r1) / 2 + normal[0] * thickness / 2
+        zc = (z0 + z1) / 2 + normal[1] * thickness / 2
+        geoms = []
+        for i in range(segments):
+            ang = 2 * math.pi * i / segments
+            quat = mat_to_quat(rot_z(ang) @ rot_y(tilt)).tolist()
+            geoms.append(self.box([thickness / 2, half_w, length / 2],
+                                  [rc * math.cos(ang), rc * math.sin(ang), zc], name=f"{name}{i}",
+                                  quat=quat))
+        return geoms
 
     def rect_walls(self, half_x: float, half_y: float, height: float, thickness: float,
                    z0: float = 0.0, rgba: RGBA | None = None, body: mujoco.MjsBody | None = None,
@@ -139,11 +156,20 @@ class PartBuilder:
         )
 
     def hinge(self, body: mujoco.MjsBody, name: str, axis: Sequence[float], range_: tuple[float, float],
-              stiffness: float = 0.0, damping: float = 0.05, springref: float = 0.0,
+              stiffness: float = 0.0, damping: float = 0.05, springref: float = 0.0, ref: float = 0.0,
               pos: Sequence[float] = (0, 0, 0)) -> mujoco.MjsJoint:
+        """A limited hinge; ``range_``, ``springref`` and ``ref`` are in radians.
+
+        MjSpec compiles joint angles in the spec's angle unit (degrees unless the compiler says
+        otherwise), so they are converted here, once, for every builder.
+        """
+        def angle(radians: float) -> float:
+            return math.degrees(radians) if body.compiler.degree else radians
+
         return body.add_joint(
             name=f"{self.prefix}/{name}", type=mujoco.mjtJoint.mjJNT_HINGE, axis=list(axis),
-            range=list(range_), limited=True, stiffness=stiffness, damping=damping,
-            springref=springref, pos=[v * self.scale for v in pos],
+            range=[angle(range_[0]), angle(range_[1])], limited=True, stiffness=stiffness,
+            damping=damping, springref=angle(springref), ref=angle(ref),
+            pos=[v * self.scale for v in pos],
         )
 

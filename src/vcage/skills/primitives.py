@@ -275,15 +275,14 @@ def pick_and_place(s: Skills, obj: str, target: str | None = None, placement: st
 @SKILLS.register("press")
 def press(s: Skills, obj: str, point: str | None = None, depth: float = 0.004,
           hold: float = 0.3) -> MotionPlan:
-    """Press ``obj``'s functional point down by its travel plus ``depth`` with the closed hand."""
+    """Press ``obj``'s functional point down by its stroke plus ``depth`` with the closed hand."""
     inst = s.world.object(obj)
     fp = CATALOG.get(inst.type_name).functional_point(point)
     pos, rot = s.world.object_pos(obj), s.world.object_mat(obj)
     top = pos + rot @ (np.asarray(fp.pos) * inst.scale)
     # the closed finger tips are FINGER_REACH below the TCP
     contact = top + [0.0, 0.0, FINGER_REACH]
-    travel = fp.travel if fp.kind != "lever" else 0.0
-    bottom = contact - [0.0, 0.0, travel * inst.scale + depth + _lever_drop(fp.kind, inst.scale)]
+    bottom = contact - [0.0, 0.0, fp.stroke * inst.scale + depth]
     yaw = s.natural_yaw(yaw_of(rot) + math.pi / 2)
     wps = [Waypoint(s.q, CLOSED, 0.3, label="close")]
     wps += s.transit(wps[-1].q, contact + [0.0, 0.0, 0.06], yaw, CLOSED)
@@ -291,10 +290,6 @@ def press(s: Skills, obj: str, point: str | None = None, depth: float = 0.004,
     wps[-1] = Waypoint(wps[-1].q, CLOSED, wps[-1].duration, hold=hold, label="press")
     wps += s.line(wps[-1].q, contact + [0.0, 0.0, 0.06], yaw, CLOSED, SLOW_SPEED, "release")
     return MotionPlan("press", tuple(wps))
-
-
-def _lever_drop(kind: str, scale: float) -> float:
-    return 0.025 * scale if kind == "lever" else 0.0
 
 
 @SKILLS.register("push")

@@ -14,35 +14,13 @@ from typing import TYPE_CHECKING
 from vcage.assets.annotations import Annotations, Grasp, Placement, StableOrientation
 from vcage.assets.catalog import CATALOG, ObjectType
 from vcage.assets.parts import PartBuilder
-from vcage.geometry import mat_to_quat, rot_y, rot_z
 
 if TYPE_CHECKING:
-    import mujoco
+    pass
 
 HALF_PI = math.pi / 2
 RIM_DROP = 0.015  # rim grasps hold the wall this far below its top
 INV_SQRT2 = 1 / math.sqrt(2)
-
-
-def _flared_wall(p: PartBuilder, r0: float, r1: float, z0: float, z1: float, thickness: float,
-                 segments: int, name: str = "wall") -> list[mujoco.MjsGeom]:
-    """A ring of box walls whose inner surface runs from radius ``r0`` at ``z0`` to ``r1`` at ``z1``.
-
-    The walls open outwards (``r1 > r0``), so a second copy of the object nests inside.
-    """
-    tilt = math.atan2(r1 - r0, z1 - z0)
-    length = math.hypot(r1 - r0, z1 - z0)
-    half_w = (r1 + thickness) * math.tan(math.pi / segments)
-    normal = (math.cos(tilt), -math.sin(tilt))  # outward normal in the (r, z) plane
-    rc = (r0 + r1) / 2 + normal[0] * thickness / 2
-    zc = (z0 + z1) / 2 + normal[1] * thickness / 2
-    geoms = []
-    for i in range(segments):
-        ang = 2 * math.pi * i / segments
-        quat = mat_to_quat(rot_z(ang) @ rot_y(tilt)).tolist()
-        geoms.append(p.box([thickness / 2, half_w, length / 2],
-                           [rc * math.cos(ang), rc * math.sin(ang), zc], name=f"{name}{i}", quat=quat))
-    return geoms
 
 
 def _rim_grasps(radius: float, z: float, angles: tuple[float, ...], width: float,
@@ -135,7 +113,7 @@ def _bowl_inner_r(z: float) -> float:
 
 def _bowl(p: PartBuilder) -> None:
     floor = p.cylinder(BOWL_R0 + BOWL_T, BOWL_FLOOR / 2, [0, 0, BOWL_FLOOR / 2], name="floor")
-    walls = _flared_wall(p, BOWL_R0, BOWL_R1, BOWL_FLOOR, BOWL_H, BOWL_T, segments=16)
+    walls = p.flared_ring(BOWL_R0, BOWL_R1, BOWL_FLOOR, BOWL_H, BOWL_T, segments=16)
     # Glazed ceramic is slippery on itself: MuJoCo takes the larger friction of a contact pair, so
     # this only matters bowl-on-bowl, where a bowl put in off-centre slides down and nests level.
     for geom in (floor, *walls):
@@ -229,7 +207,7 @@ PLATE_R0, PLATE_R1, PLATE_H, PLATE_FLOOR, PLATE_T = 0.075, 0.1, 0.018, 0.004, 0.
 
 def _plate(p: PartBuilder) -> None:
     p.cylinder(PLATE_R0 + PLATE_T, PLATE_FLOOR / 2, [0, 0, PLATE_FLOOR / 2], name="floor")
-    _flared_wall(p, PLATE_R0, PLATE_R1, PLATE_FLOOR, PLATE_H, PLATE_T, segments=24, name="rim")
+    p.flared_ring(PLATE_R0, PLATE_R1, PLATE_FLOOR, PLATE_H, PLATE_T, segments=24, name="rim")
 
 
 CATALOG.add(ObjectType(

@@ -6,7 +6,7 @@ Moving parts are child bodies with a named joint (``<instance>/<joint>``) whose 
 limit; the stapler arm is held open by a hinge spring. The rocker switch is bistable: its centre of
 mass lies above the pivot, so it rests against either limit and a press on the raised side tips it
 over (it does not spring back). Hinge angles honour the spec's angle unit (MjSpec defaults to
-degrees).
+degrees); PartBuilder.hinge converts.
 """
 
 from __future__ import annotations
@@ -33,11 +33,6 @@ BUTTON_K = 500.0  # N/m
 BUTTON_MASS = 0.005  # kg
 BUTTON_RANGE = (-0.009, 0.0)  # room for a press that overshoots the travel
 BUTTON_TRAVEL = 0.004
-
-
-def _angle(p: PartBuilder, radians: float) -> float:
-    """A hinge angle in the unit the spec's compiler expects (MjSpec defaults to degrees)."""
-    return math.degrees(radians) if p.body.compiler.degree else radians
 
 
 def _button(p: PartBuilder, pos: tuple[float, float, float], radius: float, height: float,
@@ -79,7 +74,7 @@ CATALOG.add(ObjectType(
     build=_bell, tags=frozenset({"pressable", "device", "articulated"}), scale_range=(0.95, 1.05),
     annotations=Annotations(
         functional_points=(FunctionalPoint("button", "button", (0, 0, _BELL_TOP), joint="button",
-                                           travel=BUTTON_TRAVEL),),
+                                           travel=BUTTON_TRAVEL, stroke=BUTTON_TRAVEL),),
     ),
 ))
 
@@ -118,7 +113,7 @@ CATALOG.add(ObjectType(
         grasps=(Grasp("side", (0, 0, _CLOCK_H - 0.042), yaw=HALF_PI, width=2 * CLOCK_HALF[0]),
                 Grasp("side_1", (0, 0, _CLOCK_H - 0.042), yaw=-HALF_PI, width=2 * CLOCK_HALF[0])),
         functional_points=(FunctionalPoint("button", "button", (0, 0, _CLOCK_H), joint="button",
-                                           travel=BUTTON_TRAVEL),),
+                                           travel=BUTTON_TRAVEL, stroke=BUTTON_TRAVEL),),
     ),
 ))
 
@@ -151,9 +146,8 @@ def _stapler(p: PartBuilder) -> None:
     arm.quat = mat_to_quat(rot_y(-STAPLER_OPEN)).tolist()
     arm.ipos = [STAPLER_ARM_LEN / 2 * p.scale, 0.0, 0.004 * p.scale]
     joint = p.hinge(arm, "arm", axis=(0, 1, 0),
-                    range_=(_angle(p, -STAPLER_OPEN - 0.05), _angle(p, 0.0)), stiffness=STAPLER_K,
-                    damping=0.02, springref=_angle(p, -STAPLER_OPEN))
-    joint.ref = _angle(p, -STAPLER_OPEN)
+                    range_=(-STAPLER_OPEN - 0.05, 0.0), stiffness=STAPLER_K, damping=0.02,
+                    springref=-STAPLER_OPEN, ref=-STAPLER_OPEN)
     joint.armature = 1e-4
     length = STAPLER_ARM_LEN
     p.box([length / 2, 0.016, 0.01], [length / 2, 0, 0.004], name="arm_top", body=arm)
@@ -162,6 +156,8 @@ def _stapler(p: PartBuilder) -> None:
 
 
 _STAPLER_PRESS = _vec3(_stapler_point(STAPLER_ARM_LEN - 0.015, 0.015))
+# the press point's drop from the open arm to the closed one
+_STAPLER_STROKE = round(float(_STAPLER_PRESS[2] - _stapler_point(STAPLER_ARM_LEN - 0.015, 0.015, 0.0)[2]), 4)
 _STAPLER_TOP = float(_stapler_point(STAPLER_ARM_LEN, 0.015)[2])
 CATALOG.add(ObjectType(
     name="stapler", category="device", description="a desk stapler with a spring-loaded arm",
@@ -173,7 +169,7 @@ CATALOG.add(ObjectType(
         grasps=(Grasp("body", (0.0, 0.0, 0.04), yaw=0.0, width=0.036),
                 Grasp("body_1", (0.0, 0.0, 0.04), yaw=math.pi, width=0.036)),
         functional_points=(FunctionalPoint("press", "lever", _STAPLER_PRESS, joint="arm",
-                                           travel=0.15),),
+                                           travel=0.15, stroke=_STAPLER_STROKE),),
     ),
 ))
 
@@ -200,9 +196,8 @@ def _switch(p: PartBuilder) -> None:
     rocker.ipos = [0.0, 0.0, 0.02 * p.scale]  # centre of mass above the pivot: bistable
     # No spring (stiffness 0); its reference only marks the rest ("off") side as qpos_spring.
     joint = p.hinge(rocker, "toggle", axis=(0, 1, 0),
-                    range_=(_angle(p, -SWITCH_THROW), _angle(p, SWITCH_THROW)), damping=0.01,
-                    springref=_angle(p, -SWITCH_THROW))
-    joint.ref = _angle(p, -SWITCH_THROW)
+                    range_=(-SWITCH_THROW, SWITCH_THROW), damping=0.01, springref=-SWITCH_THROW,
+                    ref=-SWITCH_THROW)
     joint.armature = 1e-4
     rx, ry, rz = SWITCH_ROCKER
     p.box([rx, ry, rz], [0, 0, rz], name="rocker", body=rocker)
@@ -212,6 +207,8 @@ def _switch(p: PartBuilder) -> None:
 
 _SWITCH_ON = _vec3(_switch_point(SWITCH_ROCKER[0] * 0.7))
 _SWITCH_OFF = _vec3(_switch_point(-SWITCH_ROCKER[0] * 0.7, SWITCH_THROW))
+# the "on" point's drop from the off pose to the fully thrown one (past vertical it tips over)
+_SWITCH_STROKE = round(float(_SWITCH_ON[2] - _switch_point(SWITCH_ROCKER[0] * 0.7, SWITCH_THROW)[2]), 4)
 _SWITCH_TOP = float(_switch_point(SWITCH_ROCKER[0])[2])
 CATALOG.add(ObjectType(
     name="switch", category="device", description="a rocker switch on a small base",
@@ -221,8 +218,10 @@ CATALOG.add(ObjectType(
     build=_switch, tags=frozenset({"pressable", "device", "articulated", "toggle"}),
     annotations=Annotations(
         functional_points=(
-            FunctionalPoint("on", "switch", _SWITCH_ON, joint="toggle", travel=0.3),
-            FunctionalPoint("off", "switch", _SWITCH_OFF, joint="toggle", travel=0.3),
+            FunctionalPoint("on", "switch", _SWITCH_ON, joint="toggle", travel=0.3,
+                            stroke=_SWITCH_STROKE),
+            FunctionalPoint("off", "switch", _SWITCH_OFF, joint="toggle", travel=0.3,
+                            stroke=_SWITCH_STROKE),
         ),
     ),
 ))
