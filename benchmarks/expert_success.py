@@ -1,6 +1,10 @@
 """Scripted-expert success rate per atomic task over N seeds, randomisation off and on.
 
+Scenes are instantiated with the chosen placement method (context-aware by default) and, with
+``--clutter N``, N distractors around the task's objects.
+
     .venv/bin/python benchmarks/expert_success.py --seeds 50 --workers 2
+    .venv/bin/python benchmarks/expert_success.py --seeds 50 --workers 2 --clutter 8
 """
 
 from __future__ import annotations
@@ -10,21 +14,24 @@ import time
 from concurrent.futures import ProcessPoolExecutor
 
 from vcage.config import Randomization
-from vcage.errors import SimulationError
-from vcage.tasks.base import TASKS
+from vcage.errors import PlacementError, SimulationError
+from vcage.scene.placement import PLACERS
+from vcage.tasks.base import TASKS, SceneConfig
 from vcage.tasks.runner import make_task, run_episode
 
 
-def _one(args: tuple[str, int, bool]) -> tuple[str, bool, int, bool, str]:
-    task, seed, randomized = args
+def _one(args: tuple[str, int, bool, SceneConfig]) -> tuple[str, bool, int, bool, str]:
+    task, seed, randomized, scene = args
     rand = Randomization() if randomized else Randomization.off()
     try:
-        res = run_episode(task, seed, rand, record=False)
+        res = run_episode(task, seed, rand, record=False, scene=scene)
         reason = res.skill_error or ("" if res.success else "predicates: " + ",".join(
             k for k, v in res.info.items() if v is False))
         return task, randomized, seed, res.success, reason
     except SimulationError as exc:
         return task, randomized, seed, False, f"unstable: {exc}"
+    except PlacementError as exc:
+        return task, randomized, seed, False, f"placement: {exc}"
 
 
 def main() -> None:
@@ -32,10 +39,13 @@ def main() -> None:
     parser.add_argument("--seeds", type=int, default=50)
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--tasks", nargs="*", default=None)
+    parser.add_argument("--placement", default="context", choices=PLACERS.names())
+    parser.add_argument("--clutter", type=int, default=0)
     args = parser.parse_args()
+    scene = SceneConfig(args.placement, args.clutter)
     make_task("stack_blocks_two")
     tasks = args.tasks or TASKS.names()
-    jobs = [(t, s, r) for t in tasks for r in (False, True) for s in range(args.seeds)]
+    jobs = [(t, s, r, scene) for t in tasks for r in (False, True) for s in range(args.seeds)]
     t0 = time.perf_counter()
     with ProcessPoolExecutor(args.workers) as pool:
         results = list(pool.map(_one, jobs, chunksize=4))
@@ -49,7 +59,8 @@ def main() -> None:
             reasons.setdefault(task, {}).setdefault(key, 0)
             reasons[task][key] += 1
     print(f"scripted-expert success over {args.seeds} seeds per task ({len(jobs)} episodes, "
-          f"{wall:.0f} s wall on {args.workers} workers)\n")
+          f"{wall:.0f} s wall on {args.workers} workers); placement {args.placement}, "
+          f"{args.clutter} distractors\n")
     print(f"{'task':28s} {'rand off':>9s} {'rand on':>9s}")
     means = {False: [], True: []}
     for task in tasks:

@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import time
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import typer
 from rich.console import Console
@@ -13,12 +14,16 @@ from rich.table import Table
 from vcage.config import Randomization
 from vcage.errors import VcageError
 
+if TYPE_CHECKING:
+    from vcage.tasks.layout import SceneConfig
+
 app = typer.Typer(add_completion=False, no_args_is_help=True,
                   help="vcage: verified robot manipulation datasets in MuJoCo.")
 console = Console()
 
 DEMO_TASKS = ("stack_blocks_two", "place_mouse_pad", "click_bell", "place_bread_basket")
 DEMO_CAMERAS = ("front", "overview", "top", "panda/wrist")
+DEMO_CLUTTER = 4  # distractors placed around each demo task's objects
 
 
 def _fail(exc: VcageError) -> None:
@@ -65,16 +70,57 @@ def list_catalog(category: str = typer.Option(None, help="only this category"),
     console.print(f"{len(objs)} object types")
 
 
+@app.command("scene")
+def scene(objects: int = typer.Option(20, min=0, help="catalog objects to place as clutter"),
+          method: str = typer.Option("context", help="placement method: context, naive, rejection"),
+          seed: int = typer.Option(0), out: Path = typer.Option(Path("out/scene")),
+          width: int = typer.Option(640), height: int = typer.Option(480)) -> None:
+    """Instantiate a cluttered table, check it in physics, and render it from the top."""
+    import numpy as np
+    from PIL import Image
+
+    from vcage.scene.compose import compose
+    from vcage.scene.layout import Distractors, LayoutSpec
+    from vcage.scene.placement import place
+    from vcage.scene.stability import check_stability
+    from vcage.sim.render import Renderer
+    from vcage.skills.reach import reach_map
+
+    try:
+        result = place(LayoutSpec(distractors=Distractors(objects)), np.random.default_rng(seed),
+                       method, reach=reach_map())
+        world = compose(result.scene).make_world()
+        report = check_stability(world)
+    except VcageError as exc:
+        _fail(exc)
+        return
+    out.mkdir(parents=True, exist_ok=True)
+    with Renderer(world, width, height) as renderer:
+        Image.fromarray(renderer.rgb("top")).save(out / f"{method}_{objects}_seed{seed}.png")
+    secs = np.asarray(result.stats.seconds) * 1000
+    (out / f"{method}_{objects}_seed{seed}.json").write_text(json.dumps(
+        {"scene": result.scene.to_dict(), "stability": report.reason(),
+         "ms_per_object": secs.tolist(), "backtracks": result.stats.backtracks}, indent=2))
+    verdict = "[green]valid[/green]" if report.ok else f"[red]invalid[/red]: {report.reason()}"
+    console.print(f"{method}: placed {result.stats.placed} objects in {secs.sum():.1f} ms "
+                  f"(median {np.median(secs) if secs.size else 0:.2f} ms/object, "
+                  f"{result.stats.backtracks} backtracks, {result.stats.coverage:.0%} of the table "
+                  f"covered); after settling: {verdict}")
+    console.print(f"image and scene spec in {out}/")
+
+
 @app.command("run")
 def run(task: str = typer.Argument(..., help="atomic task name (see `vcage tasks`)"),
         episodes: int = typer.Option(1, min=1), seed: int = typer.Option(0),
         randomize: bool = typer.Option(True, help="domain randomisation on/off"),
         out: Path = typer.Option(Path("out/run"), help="where images and results go"),
+        placement: str = typer.Option("context", help="placement method: context, naive, rejection"),
+        clutter: int = typer.Option(0, min=0, help="distractors added around the task's objects"),
         width: int = typer.Option(320), height: int = typer.Option(240)) -> None:
     """Run the scripted expert of TASK and save before/after images of every episode."""
     try:
         rows = _run_tasks([task] * episodes, [seed + i for i in range(episodes)], randomize, out,
-                          width, height)
+                          width, height, _scene_config(placement, clutter))
     except VcageError as exc:
         _fail(exc)
         return
@@ -83,18 +129,26 @@ def run(task: str = typer.Argument(..., help="atomic task name (see `vcage tasks
 
 @app.command("demo")
 def demo(out: Path = typer.Option(Path("out/demo")), seed: int = typer.Option(0),
+         clutter: int = typer.Option(DEMO_CLUTTER, min=0, help="distractors per scene"),
          width: int = typer.Option(320), height: int = typer.Option(240)) -> None:
-    """Run a few atomic tasks with their scripted experts and write rendered images."""
+    """Run a few atomic tasks in cluttered scenes with their scripted experts; write images."""
     try:
-        rows = _run_tasks(list(DEMO_TASKS), [seed] * len(DEMO_TASKS), True, out, width, height)
+        rows = _run_tasks(list(DEMO_TASKS), [seed] * len(DEMO_TASKS), True, out, width, height,
+                          _scene_config("context", clutter))
     except VcageError as exc:
         _fail(exc)
         return
     _print_results(rows, out)
 
 
+def _scene_config(placement: str, clutter: int) -> SceneConfig:
+    from vcage.tasks.layout import SceneConfig
+
+    return SceneConfig(placement, clutter)
+
+
 def _run_tasks(tasks: list[str], seeds: list[int], randomize: bool, out: Path, width: int,
-               height: int) -> list[dict]:
+               height: int, scene: SceneConfig) -> list[dict]:
     from PIL import Image
 
     from vcage.sim.render import Renderer
@@ -105,7 +159,7 @@ def _run_tasks(tasks: list[str], seeds: list[int], randomize: bool, out: Path, w
     rows = []
     for task, seed in zip(tasks, seeds, strict=True):
         t0 = time.perf_counter()
-        result = run_episode(task, seed, rand)
+        result = run_episode(task, seed, rand, scene=scene)
         elapsed = time.perf_counter() - t0
         world = result.world
         final = world.get_state()

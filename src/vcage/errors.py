@@ -29,6 +29,10 @@ class SceneError(VcageError):
     """A scene cannot be composed as specified."""
 
 
+class PlacementError(SceneError):
+    """Objects cannot be placed as specified: a constraint is impossible or the free space ran out."""
+
+
 class SimulationError(VcageError):
     """The physics became unstable (NaN, exploding velocities); the episode must not be recorded."""
 

@@ -127,6 +127,15 @@ class World:
         roots = self.model.body_rootid[self.model.geom_bodyid[geom_ids]]
         return self._root_to_object[roots]
 
+    def body_owner(self, body_id: int) -> str:
+        """The object a body belongs to, else the name of its root body (``table``, the robot's
+        base, ``world`` for the floor)."""
+        root = int(self.model.body_rootid[body_id])
+        idx = int(self._root_to_object[root])
+        if idx >= 0:
+            return self.object_names[idx]
+        return self.model.body(root).name or "world"
+
     def table_top(self) -> float:
         """Height of the table's top surface."""
         geom = self.model.geom("table/top")

@@ -13,12 +13,15 @@ import numpy as np
 
 from vcage.config import Randomization
 from vcage.registry import Registry
+from vcage.scene.layout import Relation, ReservedZone
+from vcage.scene.placement import PlacementStats, place
 from vcage.scene.spec import SceneSpec
 from vcage.sim.world import World
 from vcage.skills.primitives import Skills
-from vcage.tasks.layout import Item, randomize
+from vcage.skills.reach import reach_map
+from vcage.tasks.layout import Item, SceneConfig, task_layout
 
-__all__ = ["TASKS", "AtomicTask", "Item", "Latch"]
+__all__ = ["TASKS", "AtomicTask", "Item", "Latch", "SceneConfig"]
 
 
 class AtomicTask(ABC):
@@ -27,18 +30,26 @@ class AtomicTask(ABC):
     name: ClassVar[str]
     instructions: ClassVar[tuple[str, ...]]  # templates formatted with :meth:`words`
     items: ClassVar[tuple[Item, ...]] = ()
+    relations: ClassVar[tuple[Relation, ...]] = ()  # between items, kept when randomised
+    reserved: ClassVar[tuple[ReservedZone, ...]] = ()  # table regions the expert will use
     hold_steps: ClassVar[int] = 5  # success must hold this many consecutive control steps
 
     def __init__(self) -> None:
         self.spec: SceneSpec | None = None
+        self.placement_stats: PlacementStats | None = None
 
     # -- scene -----------------------------------------------------------------------------
     def layout(self, rng: np.random.Generator) -> tuple[Item, ...]:
         """The nominal items of this episode (override to sample e.g. which object goes where)."""
         return self.items
 
-    def build(self, rng: np.random.Generator, rand: Randomization) -> SceneSpec:
-        self.spec = randomize(self.layout(rng), rng, rand)
+    def build(self, rng: np.random.Generator, rand: Randomization,
+              scene: SceneConfig | None = None) -> SceneSpec:
+        """Lay out this episode's items and place them (context-aware unless ``scene`` says)."""
+        scene = scene or SceneConfig()
+        layout = task_layout(self.layout(rng), rng, rand, self.relations, self.reserved, scene.clutter)
+        result = place(layout, rng, scene.placement, scene.config, reach_map())
+        self.spec, self.placement_stats = result.scene, result.stats
         return self.spec
 
     def setup(self, world: World) -> None:

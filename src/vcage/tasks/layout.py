@@ -1,15 +1,23 @@
-"""Seeded domain randomisation of a task's nominal layout into a :class:`SceneSpec`."""
+"""A task's nominal items, seeded domain randomisation, and the :class:`LayoutSpec` they make.
+
+The layout goes through a placement method (context-aware by default), so randomised poses never
+interpenetrate and clutter can be added around the task's objects.
+"""
 
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import asdict, dataclass, field
+from typing import Any
 
 import numpy as np
 
 from vcage.assets.catalog import CATALOG
 from vcage.config import Randomization, Range
-from vcage.scene.spec import ObjectSpec, SceneSpec, TableSpec
+from vcage.errors import ConfigError
+from vcage.scene.layout import Distractors, LayoutObject, LayoutSpec, Region, Relation, ReservedZone
+from vcage.scene.placement import DEFAULT_METHOD, PLACERS, PlacementConfig
+from vcage.scene.spec import TableSpec
 
 TABLE_COLORS = ((0.62, 0.47, 0.33, 1.0), (0.75, 0.75, 0.72, 1.0), (0.35, 0.28, 0.22, 1.0),
                 (0.55, 0.6, 0.65, 1.0))
@@ -30,38 +38,66 @@ class Item:
     jitter: bool = True  # False pins the pose (still scaled/coloured when randomised)
 
 
+@dataclass(frozen=True)
+class SceneConfig:
+    """How a task's scene is instantiated: placement method, clutter, and placement settings."""
+
+    placement: str = DEFAULT_METHOD  # "context" | "naive" | "rejection"
+    clutter: int = 0  # distractors added around the task's objects
+    config: PlacementConfig = field(default_factory=PlacementConfig)
+
+    def __post_init__(self) -> None:
+        PLACERS.get(self.placement)  # unknown methods list the valid ones
+        if self.clutter < 0:
+            raise ConfigError(f"clutter {self.clutter} must be >= 0")
+
+    def to_dict(self) -> dict[str, Any]:
+        return asdict(self)
+
+
 def _uniform(rng: np.random.Generator, r: Range) -> float:
     return float(rng.uniform(r.low, r.high)) if r.width > 0 else r.low
 
 
-def randomize(items: Sequence[Item], rng: np.random.Generator, rand: Randomization) -> SceneSpec:
-    """The scene for ``items``: nominal when ``rand.enabled`` is False, else randomised by ``rng``."""
+def task_layout(items: Sequence[Item], rng: np.random.Generator, rand: Randomization,
+                relations: Sequence[Relation] = (), reserved: Sequence[ReservedZone] = (),
+                clutter: int = 0) -> LayoutSpec:
+    """The layout of ``items``: nominal poses when ``rand.enabled`` is False; otherwise each
+    item's origin may go anywhere in its jitter box and its yaw anywhere in its jitter range, and
+    scale, colour, friction, table, light and cameras are drawn from ``rng``."""
     objects = []
     for item in items:
         otype = CATALOG.get(item.type)
         variants = item.colors or tuple(otype.colors)
+        if not rand.enabled or not item.jitter:
+            region, yaw = Region(item.xy), (item.yaw, item.yaw)
+        else:
+            lo, hi = rand.object_xy.low, rand.object_xy.high
+            mid = (lo + hi) / 2
+            region = Region((item.xy[0] + mid, item.xy[1] + mid), ((hi - lo) / 2, (hi - lo) / 2))
+            yaw = (item.yaw + rand.object_yaw.low, item.yaw + rand.object_yaw.high)
         if not rand.enabled:
-            objects.append(ObjectSpec(item.name, item.type, item.xy, item.yaw, 1.0, variants[0]))
+            objects.append(LayoutObject(item.name, item.type, region=region, yaw=yaw,
+                                        color=variants[0]))
             continue
-        lo = max(otype.scale_range[0], rand.scale.low)
-        hi = min(otype.scale_range[1], rand.scale.high)
-        jitter = item.jitter
-        xy = (item.xy[0] + (_uniform(rng, rand.object_xy) if jitter else 0.0),
-              item.xy[1] + (_uniform(rng, rand.object_xy) if jitter else 0.0))
-        objects.append(ObjectSpec(
-            item.name, item.type, xy,
-            yaw=item.yaw + (_uniform(rng, rand.object_yaw) if jitter else 0.0),
-            scale=float(rng.uniform(lo, hi)) if hi > lo else 1.0,
+        lo_s = max(otype.scale_range[0], rand.scale.low)
+        hi_s = min(otype.scale_range[1], rand.scale.high)
+        objects.append(LayoutObject(
+            item.name, item.type, region=region, yaw=yaw,
+            scale=float(rng.uniform(lo_s, hi_s)) if hi_s > lo_s else 1.0,
             color=str(variants[rng.integers(len(variants))]) if rand.color else variants[0],
             friction=_uniform(rng, rand.friction),
         ))
+    common = {"objects": tuple(objects), "relations": tuple(relations), "reserved": tuple(reserved),
+              "distractors": Distractors(clutter)}
     if not rand.enabled:
-        return SceneSpec(objects=tuple(objects))
+        return LayoutSpec(**common)  # type: ignore[arg-type]
     table = TableSpec(
         height=NOMINAL_TABLE_HEIGHT + _uniform(rng, rand.table_height),
         rgba=TABLE_COLORS[rng.integers(len(TABLE_COLORS))] if rand.color else TABLE_COLORS[0],
         texture=TABLE_TEXTURES[rng.integers(len(TABLE_TEXTURES))] if rand.color else "plain",
     )
-    cam = tuple(_uniform(rng, rand.camera_jitter) for _ in range(3))
-    return SceneSpec(objects=tuple(objects), table=table, light=_uniform(rng, rand.light),
-                     camera_offset=cam)  # type: ignore[arg-type]
+    cam = (_uniform(rng, rand.camera_jitter), _uniform(rng, rand.camera_jitter),
+           _uniform(rng, rand.camera_jitter))
+    return LayoutSpec(**common, table=table, light=_uniform(rng, rand.light),  # type: ignore[arg-type]
+                      camera_offset=cam)

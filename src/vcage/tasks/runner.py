@@ -14,7 +14,7 @@ from vcage.scene.spec import SceneSpec
 from vcage.sim.world import World
 from vcage.skills.executor import Recording
 from vcage.skills.primitives import Skills
-from vcage.tasks.base import TASKS, AtomicTask
+from vcage.tasks.base import TASKS, AtomicTask, SceneConfig
 
 SETTLE_SECONDS = 0.3
 
@@ -39,12 +39,12 @@ def make_task(name: str) -> AtomicTask:
     return TASKS.get(name)()
 
 
-def prepare(name: str, seed: int, rand: Randomization,
-            sim: SimConfig = SimConfig()) -> tuple[AtomicTask, World, np.random.Generator]:
+def prepare(name: str, seed: int, rand: Randomization, sim: SimConfig = SimConfig(),
+            scene: SceneConfig | None = None) -> tuple[AtomicTask, World, np.random.Generator]:
     """Build and compose the task's scene for ``seed`` and let it settle."""
     task = make_task(name)
     rng = np.random.default_rng(seed)
-    spec = task.build(rng, rand)
+    spec = task.build(rng, rand, scene)
     world = compose(spec, sim).make_world(sim)
     world.settle(SETTLE_SECONDS)
     task.setup(world)
@@ -52,14 +52,15 @@ def prepare(name: str, seed: int, rand: Randomization,
 
 
 def run_episode(name: str, seed: int, rand: Randomization | None = None,
-                sim: SimConfig = SimConfig(), record: bool = True) -> EpisodeResult:
+                sim: SimConfig = SimConfig(), record: bool = True,
+                scene: SceneConfig | None = None) -> EpisodeResult:
     """Run the scripted expert of task ``name`` on the scene of ``seed``.
 
     A skill that cannot plan (unreachable, no grasp) ends the episode as a failure with its
     message; a :class:`SimulationError` propagates, since an unstable rollout is not data.
     """
     rand = Randomization() if rand is None else rand
-    task, world, rng = prepare(name, seed, rand, sim)
+    task, world, rng = prepare(name, seed, rand, sim, scene)
     instruction = task.instruction(rng)
     initial = world.get_state()
     skills = Skills(world)

@@ -8,7 +8,7 @@ import numpy as np
 
 from vcage.config import Randomization
 from vcage.scene.spec import SceneSpec
-from vcage.tasks.base import TASKS, Item
+from vcage.tasks.base import TASKS, Item, SceneConfig
 from vcage.tasks.templates import PlaceTask
 
 NEST_RATIO = 0.92  # the inner bowl is at most this fraction of the outer bowl's scale
@@ -21,8 +21,9 @@ class StackBowlsTwo(PlaceTask):
     items = (Item("bowl_a", "bowl", (0.47, -0.16)), Item("bowl_b", "bowl", (0.57, 0.13)))
     obj, target, relation, need_upright = "bowl_a", "bowl_b", "inside", True
 
-    def build(self, rng: np.random.Generator, rand: Randomization) -> SceneSpec:
-        spec = super().build(rng, rand)
+    def build(self, rng: np.random.Generator, rand: Randomization,
+              scene: SceneConfig | None = None) -> SceneSpec:
+        spec = super().build(rng, rand, scene)
         inner, outer = spec.object("bowl_a"), spec.object("bowl_b")
         if inner.scale > outer.scale * NEST_RATIO and rand.enabled:
             # Bowls only nest when the one put inside is smaller; keep the randomised sizes

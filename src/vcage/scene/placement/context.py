@@ -1,0 +1,174 @@
+"""Context-aware placement: sample every object from the free space of a prohibited-region map.
+
+Each support surface has a :class:`SurfaceMap`. The table's map starts with the robot base's
+keep-out and the reserved zones; every placed footprint is added to it. An object's origin is
+drawn uniformly from its domain (the table eroded by its footprint, within the arm's top-down
+reach, its region and its relations) minus the configuration-space obstacles of everything on the
+map, at a sampled yaw. Distractors keep extra clearance from task objects (more when tall). When
+an object does not fit, the most recently placed distractors are taken off again and re-placed
+after it, a bounded number of times; then a :class:`PlacementError` names the object, the surface
+and the free area left.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+import shapely
+from shapely.geometry import Point, Polygon
+from shapely.geometry.base import BaseGeometry
+
+from vcage.errors import PlacementError
+from vcage.scene.layout import LayoutObject, LayoutSpec
+from vcage.scene.placement.base import PLACERS, PlacementStats, Placer, Pose, height, support_frame
+from vcage.scene.placement.free_space import Occupant, SurfaceMap
+from vcage.scene.placement.geometry import erode_box, footprint, sample_point
+from vcage.scene.spec import ROBOT_MOUNT
+
+FAR = 10.0  # half-planes are boxes this large
+
+
+@PLACERS.register("context")
+class ContextAwarePlacer(Placer):
+    name = "context"
+
+    def begin(self, layout: LayoutSpec) -> None:
+        cfg = self.config
+        (x0, x1), (y0, y1) = layout.table.x_range, layout.table.y_range
+        self.layout = layout
+        self.objects: dict[str, LayoutObject] = {o.name: o for o in layout.objects}
+        self.table_box = (x0 + cfg.edge_margin, y0 + cfg.edge_margin,
+                          x1 - cfg.edge_margin, y1 - cfg.edge_margin)
+        self.reach_region = None if self.reach is None else self.reach.region(layout.table.height)
+        top = shapely.box(x0, y0, x1, y1)
+        usable = top if self.reach_region is None else top.intersection(self.reach_region)
+        table = SurfaceMap("table", top, usable)
+        table.forbid("robot base", Point(ROBOT_MOUNT[:2]).buffer(cfg.base_keepout, 16))
+        for zone in layout.reserved:
+            table.forbid(f"reserved zone {zone.name!r}", shapely.box(*zone.region.bounds))
+        self.maps: dict[str, SurfaceMap] = {"table": table}
+        self.backtracks = 0
+
+    # -- placing with backtracking ---------------------------------------------------------------
+    def place_all(self, objects: list[LayoutObject], rng: np.random.Generator,
+                  stats: PlacementStats) -> dict[str, Pose]:
+        self.objects.update({o.name: o for o in objects})
+        poses: dict[str, Pose] = {}
+        elapsed: dict[str, float] = {}
+        order: list[str] = []
+        queue = list(objects)
+        while queue:
+            obj = queue.pop(0)
+            t0 = time.perf_counter()
+            pose = self._place_one(obj, poses, rng)
+            if pose is not None:
+                self._commit(obj, pose)
+                poses[obj.name] = pose
+                order.append(obj.name)
+            else:
+                victim = next((n for n in reversed(order) if not self.objects[n].task), None)
+                if victim is None or stats.backtracks >= self.config.max_backtracks:
+                    raise self.failure(obj, poses)
+                stats.backtracks = self.backtracks = stats.backtracks + 1
+                self._uncommit(self.objects[victim])
+                del poses[victim]
+                order.remove(victim)
+                queue[:0] = [obj, self.objects[victim]]
+            elapsed[obj.name] = elapsed.get(obj.name, 0.0) + time.perf_counter() - t0
+        stats.seconds.extend(elapsed[n] for n in order)
+        return poses
+
+    def _place_one(self, obj: LayoutObject, poses: dict[str, Pose],
+                   rng: np.random.Generator) -> Pose | None:
+        surface = self._surface(obj, poses)
+        tall = height(obj) > self.config.tall_height
+        pinned = obj.region is not None and max(obj.region.half) == 0 and obj.support.is_table
+        fixed_yaw = obj.yaw[0] == obj.yaw[1]
+        tries = 1 if fixed_yaw else self.config.yaw_tries
+        for _ in range(tries):
+            yaw = obj.yaw[0] if fixed_yaw else float(rng.uniform(*obj.yaw))
+            shape = footprint(obj.type, obj.scale, yaw)
+            domain = self._domain(obj, shape, poses)
+            grown = shape.buffer(self.config.margin, join_style="mitre")
+            free = surface.free(grown, obj.task, tall, self._clearance, domain)
+            if pinned:
+                assert obj.region is not None
+                if free.distance(Point(obj.region.center)) <= 1e-9:
+                    return Pose(obj.region.center, yaw)
+                continue
+            xy = sample_point(free, rng)
+            if xy is not None:
+                return Pose(xy, yaw)
+        return None
+
+    # -- the map ------------------------------------------------------------------------------------
+    def _surface(self, obj: LayoutObject, poses: dict[str, Pose]) -> SurfaceMap:
+        label = obj.support.label()
+        if label not in self.maps:
+            center, yaw, half = support_frame(obj, poses, self.objects)
+            self.maps[label] = SurfaceMap(label, _rect(center, yaw, half))
+        return self.maps[label]
+
+    def _domain(self, obj: LayoutObject, shape: Polygon, poses: dict[str, Pose]) -> BaseGeometry:
+        """Where ``obj``'s origin may go before anything else on the surface is considered."""
+        if not obj.support.is_table:
+            return self._surface(obj, poses).surface  # the origin stays in the placement region
+        domain: BaseGeometry = erode_box(self.table_box, shape)
+        if self.reach_region is not None and (obj.task or self.config.reach_distractors):
+            domain = domain.intersection(self.reach_region)
+        if obj.region is not None:
+            x0, y0, x1, y1 = obj.region.bounds
+            domain = domain.intersection(shapely.box(x0 - 1e-9, y0 - 1e-9, x1 + 1e-9, y1 + 1e-9))
+        for rel in self.layout.relations:
+            if rel.a == obj.name:
+                domain = domain.intersection(_relation_region(rel.kind, poses[rel.b].xy, rel.distance)) \
+                    if rel.kind != "far_from" else \
+                    domain.difference(Point(poses[rel.b].xy).buffer(rel.distance, 32))
+        return domain
+
+    def _clearance(self, occ: Occupant, task: bool, tall: bool) -> float:
+        if occ.task == task:
+            return 0.0
+        distractor_tall = tall if occ.task else occ.tall
+        return self.config.tall_clearance if distractor_tall else self.config.task_clearance
+
+    def _commit(self, obj: LayoutObject, pose: Pose) -> None:
+        occ = Occupant(obj.name, footprint(obj.type, obj.scale, pose.yaw, pose.xy), obj.task,
+                       height(obj) > self.config.tall_height)
+        self.maps["table"].add(occ)
+        if not obj.support.is_table:
+            self.maps[obj.support.label()].add(occ)
+
+    def _uncommit(self, obj: LayoutObject) -> None:
+        self.maps["table"].remove(obj.name)
+        if not obj.support.is_table:
+            self.maps[obj.support.label()].remove(obj.name)
+
+    # -- reporting ----------------------------------------------------------------------------------
+    def failure(self, obj: LayoutObject, poses: dict[str, Pose]) -> PlacementError:
+        surface = self.maps.get(obj.support.label(), self.maps["table"])
+        free = surface.free_area()
+        size = footprint(obj.type, obj.scale, 0.0).bounds
+        return PlacementError(
+            f"no free space for {obj.name!r} ({obj.type}, footprint {size[2] - size[0]:.3f} x "
+            f"{size[3] - size[1]:.3f} m) on {surface.label}: {free:.3f} m² of the "
+            f"{surface.usable.area:.3f} m² within reach is free but no gap fits it (with "
+            f"{len(poses)} objects placed, after {self.backtracks} backtracks); use fewer or "
+            "smaller objects, a larger table, or a wider region")
+
+
+def _rect(center: np.ndarray, yaw: float, half: np.ndarray) -> Polygon:
+    c, s = math.cos(yaw), math.sin(yaw)
+    hx, hy = max(float(half[0]), 1e-4), max(float(half[1]), 1e-4)
+    return Polygon([(center[0] + x * c - y * s, center[1] + x * s + y * c)
+                    for x, y in ((hx, hy), (-hx, hy), (-hx, -hy), (hx, -hy))])
+
+
+def _relation_region(kind: str, b: tuple[float, float], distance: float) -> BaseGeometry:
+    if kind == "left_of":  # +y is left as seen from the robot
+        return shapely.box(-FAR, b[1] + distance, FAR, FAR)
+    if kind == "right_of":
+        return shapely.box(-FAR, -FAR, FAR, b[1] - distance)
+    return Point(b).buffer(distance, 32)  # near

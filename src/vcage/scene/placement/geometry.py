@@ -1,0 +1,83 @@
+"""Planar geometry for placement: footprints, configuration-space obstacles, uniform sampling.
+
+Positions are the (x, y) of an object's origin. For a new object with footprint ``F`` (a convex
+polygon about its origin at a given yaw), the origins where it would overlap an obstacle ``O`` form
+the Minkowski sum ``O ⊕ (−F)``; for convex polygons that is the convex hull of all vertex sums.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import shapely
+from shapely.geometry import MultiPoint, Point, Polygon
+from shapely.geometry.base import BaseGeometry
+
+from vcage.assets.catalog import CATALOG
+
+EMPTY = Polygon()
+
+
+def footprint(type_name: str, scale: float, yaw: float, xy: tuple[float, float] = (0.0, 0.0),
+              pad: float = 0.0) -> Polygon:
+    """The object's resting rectangle (its size box, grown by ``pad``) at ``xy`` and ``yaw``."""
+    sx, sy = (s * scale for s in CATALOG.get(type_name).size[:2])
+    hx, hy = sx / 2 + pad, sy / 2 + pad
+    c, s = math.cos(yaw), math.sin(yaw)
+    corners = [(x * c - y * s + xy[0], x * s + y * c + xy[1])
+               for x, y in ((hx, hy), (-hx, hy), (-hx, -hy), (hx, -hy))]
+    return Polygon(corners)
+
+
+def minkowski_cobstacle(obstacle: Polygon, shape: Polygon) -> Polygon:
+    """Origins at which ``shape`` (a convex polygon about the origin) touches convex ``obstacle``."""
+    a = np.asarray(obstacle.exterior.coords)[:-1]
+    b = -np.asarray(shape.exterior.coords)[:-1]
+    sums = (a[:, None, :] + b[None, :, :]).reshape(-1, 2)
+    hull = MultiPoint(sums).convex_hull
+    return hull if isinstance(hull, Polygon) else EMPTY
+
+
+def erode_box(bounds: tuple[float, float, float, float], shape: Polygon) -> Polygon:
+    """Origins at which ``shape`` lies inside the axis-aligned box ``bounds`` (exact for a box)."""
+    sx0, sy0, sx1, sy1 = shape.bounds
+    x0, y0, x1, y1 = bounds
+    x0, y0, x1, y1 = x0 - sx0, y0 - sy0, x1 - sx1, y1 - sy1
+    if x1 < x0 or y1 < y0:
+        return EMPTY
+    return shapely.box(x0, y0, x1, y1)
+
+
+def annulus(center: tuple[float, float], r_in: float, r_out: float, resolution: int = 32) -> BaseGeometry:
+    ring = Point(center).buffer(r_out, resolution)
+    return ring.difference(Point(center).buffer(r_in, resolution)) if r_in > 0 else ring
+
+
+def sample_point(region: BaseGeometry, rng: np.random.Generator) -> tuple[float, float] | None:
+    """A point drawn uniformly from the area of ``region`` (None if it has no area).
+
+    The region is triangulated (constrained Delaunay, holes respected); a triangle is drawn in
+    proportion to its area and a point uniformly inside it.
+    """
+    if region.is_empty or region.area <= 1e-12:
+        return None
+    polys = [g for g in getattr(region, "geoms", [region]) if isinstance(g, Polygon) and g.area > 0]
+    tris = []
+    for poly in polys:
+        tris.extend(shapely.constrained_delaunay_triangles(poly).geoms)
+    areas = np.array([t.area for t in tris])
+    if areas.sum() <= 0:
+        return None
+    tri = tris[int(rng.choice(len(tris), p=areas / areas.sum()))]
+    a, b, c = np.asarray(tri.exterior.coords)[:3]
+    u, v = rng.random(2)
+    if u + v > 1:
+        u, v = 1 - u, 1 - v
+    p = a + u * (b - a) + v * (c - a)
+    return float(p[0]), float(p[1])
+
+
+def point_region(xy: tuple[float, float], tol: float = 1e-4) -> Polygon:
+    """A tiny square around ``xy``: a pinned position that must still be free."""
+    return shapely.box(xy[0] - tol, xy[1] - tol, xy[0] + tol, xy[1] + tol)
