@@ -43,3 +43,20 @@ def test_naive_placement_interpenetrates_in_clutter():
     reports = [_check(place(LayoutSpec(distractors=Distractors(20)), np.random.default_rng(s),
                             method="naive").scene) for s in range(2)]
     assert any(r.interpenetrating for r in reports)
+
+
+def test_objects_on_and_in_supports_rest_stably():
+    from vcage.scene.layout import LayoutObject as L
+    from vcage.scene.layout import Support
+
+    objs = (L("basket", "basket"), L("bread", "bread", support=Support("basket")),
+            L("tray", "tray"), L("sponge", "sponge", support=Support("tray")),
+            L("apple", "apple", support=Support("tray")),
+            L("b1", "block"), L("b2", "block", support=Support("b1")),
+            L("b3", "block", support=Support("b2")),
+            L("pad", "mouse_pad"), L("mouse", "mouse", support=Support("pad")))
+    for seed in range(2):
+        scene = place(LayoutSpec(objects=objs, distractors=Distractors(4)),
+                      np.random.default_rng(seed), reach=reach_map()).scene
+        report = _check(scene)
+        assert report.ok, report.reason()

@@ -53,3 +53,43 @@ def test_press_success_is_latched_not_instantaneous() -> None:
     # the button springs back after the press, yet the latched press counts
     assert result.success and result.info["pressed"]
     assert result.world.data.joint("bell/button").qpos[0] > -0.002
+
+
+@pytest.mark.parametrize("name", ALL_TASKS)
+def test_task_scenes_go_through_context_aware_placement(name: str) -> None:
+    from vcage.scene.placement.geometry import footprint
+    from vcage.tasks.base import SceneConfig
+
+    task = make_task(name)
+    spec = task.build(np.random.default_rng(5), Randomization(), SceneConfig(clutter=6))
+    assert task.placement_stats is not None and task.placement_stats.method == "context"
+    clutter = [o for o in spec.objects if o.name.startswith("clutter")]
+    assert len(clutter) == 6
+    shapes = {o.name: footprint(o.type, o.scale, o.yaw, o.xy) for o in spec.objects}
+    names = list(shapes)
+    for i, a in enumerate(names):
+        for b in names[i + 1:]:
+            assert not shapes[a].intersects(shapes[b]), (a, b)
+    for zone in task.reserved:
+        import shapely
+
+        assert not any(shapely.box(*zone.region.bounds).intersects(shapes[o.name]) for o in clutter)
+
+
+@pytest.mark.parametrize("name", ["stack_blocks_three", "place_bread_basket", "click_alarmclock"])
+def test_experts_work_in_clutter(name: str) -> None:
+    from vcage.tasks.base import SceneConfig
+
+    result = run_episode(name, seed=2, record=False, scene=SceneConfig(clutter=8))
+    assert result.success, (result.info, result.skill_error)
+    assert sum(o.name.startswith("clutter") for o in result.spec.objects) == 8
+
+
+def test_naive_task_placement_is_available_for_comparison() -> None:
+    from vcage.tasks.base import SceneConfig
+
+    task = make_task("stack_blocks_two")
+    task.build(np.random.default_rng(0), Randomization(), SceneConfig("naive", clutter=4))
+    assert task.placement_stats is not None and task.placement_stats.method == "naive"
+    with pytest.raises(RegistryError, match="context, naive, rejection"):
+        SceneConfig("magic")

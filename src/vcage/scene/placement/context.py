@@ -17,9 +17,11 @@ import time
 
 import numpy as np
 import shapely
+from shapely import affinity
 from shapely.geometry import Point, Polygon
 from shapely.geometry.base import BaseGeometry
 
+from vcage.assets.catalog import CATALOG
 from vcage.errors import PlacementError
 from vcage.scene.layout import LayoutObject, LayoutSpec
 from vcage.scene.placement.base import PLACERS, PlacementStats, Placer, Pose, height, support_frame
@@ -28,6 +30,10 @@ from vcage.scene.placement.geometry import erode_box, footprint, sample_point
 from vcage.scene.spec import ROBOT_MOUNT
 
 FAR = 10.0  # half-planes are boxes this large
+FULL_TURN = (-math.pi, math.pi)
+# Objects put on another one keep their origin over the middle half of its surface, so that a
+# stack of several stays statically stable.
+ON_INSET = 0.5
 
 
 @PLACERS.register("context")
@@ -85,10 +91,7 @@ class ContextAwarePlacer(Placer):
         surface = self._surface(obj, poses)
         tall = height(obj) > self.config.tall_height
         pinned = obj.region is not None and max(obj.region.half) == 0 and obj.support.is_table
-        fixed_yaw = obj.yaw[0] == obj.yaw[1]
-        tries = 1 if fixed_yaw else self.config.yaw_tries
-        for _ in range(tries):
-            yaw = obj.yaw[0] if fixed_yaw else float(rng.uniform(*obj.yaw))
+        for yaw in self._yaws(obj, poses, rng):
             shape = footprint(obj.type, obj.scale, yaw)
             domain = self._domain(obj, shape, poses)
             grown = shape.buffer(self.config.margin, join_style="mitre")
@@ -114,7 +117,7 @@ class ContextAwarePlacer(Placer):
     def _domain(self, obj: LayoutObject, shape: Polygon, poses: dict[str, Pose]) -> BaseGeometry:
         """Where ``obj``'s origin may go before anything else on the surface is considered."""
         if not obj.support.is_table:
-            return self._surface(obj, poses).surface  # the origin stays in the placement region
+            return self._support_domain(obj, shape, poses)
         domain: BaseGeometry = erode_box(self.table_box, shape)
         if self.reach_region is not None and (obj.task or self.config.reach_distractors):
             domain = domain.intersection(self.reach_region)
@@ -127,6 +130,36 @@ class ContextAwarePlacer(Placer):
                     if rel.kind != "far_from" else \
                     domain.difference(Point(poses[rel.b].xy).buffer(rel.distance, 32))
         return domain
+
+    def _support_domain(self, obj: LayoutObject, shape: Polygon, poses: dict[str, Pose]) -> BaseGeometry:
+        """On a surface the origin stays in the placement region (overhang allowed); in a
+        container the whole footprint stays in it, so the object clears the walls."""
+        center, syaw, half = support_frame(obj, poses, self.objects)
+        if self._support_kind(obj) == "on":  # the origin stays over the middle of the surface
+            return _rect(center, syaw, half * ON_INSET)
+        local_shape = affinity.rotate(shape, -syaw, origin=(0, 0), use_radians=True)
+        local = erode_box((-half[0], -half[1], half[0], half[1]), local_shape)
+        if local.is_empty:
+            return local
+        return affinity.translate(affinity.rotate(local, syaw, origin=(0, 0), use_radians=True),
+                                  center[0], center[1])
+
+    def _support_kind(self, obj: LayoutObject) -> str:
+        assert obj.support.obj is not None
+        host = self.objects[obj.support.obj]
+        return CATALOG.get(host.type).placement(obj.support.placement).kind
+
+    def _yaws(self, obj: LayoutObject, poses: dict[str, Pose], rng: np.random.Generator) -> list[float]:
+        """The yaws to try, in order."""
+        if obj.yaw[0] == obj.yaw[1]:
+            return [obj.yaw[0]]
+        if not obj.support.is_table and obj.yaw == FULL_TURN and self._support_kind(obj) == "in":
+            # in a container, line up with its walls: each quarter turn once, slightly jittered
+            assert obj.support.obj is not None
+            host_yaw = poses[obj.support.obj].yaw
+            return [host_yaw + int(k) * math.pi / 2 + float(rng.uniform(-0.1, 0.1))
+                    for k in rng.permutation(4)]
+        return [float(rng.uniform(*obj.yaw)) for _ in range(self.config.yaw_tries)]
 
     def _clearance(self, occ: Occupant, task: bool, tall: bool) -> float:
         if occ.task == task:
@@ -151,10 +184,11 @@ class ContextAwarePlacer(Placer):
         surface = self.maps.get(obj.support.label(), self.maps["table"])
         free = surface.free_area()
         size = footprint(obj.type, obj.scale, 0.0).bounds
+        where = "within the arm's reach" if surface.label == "table" else "in the placement region"
         return PlacementError(
             f"no free space for {obj.name!r} ({obj.type}, footprint {size[2] - size[0]:.3f} x "
             f"{size[3] - size[1]:.3f} m) on {surface.label}: {free:.3f} m² of the "
-            f"{surface.usable.area:.3f} m² within reach is free but no gap fits it (with "
+            f"{surface.usable.area:.3f} m² {where} is free but no gap fits it (with "
             f"{len(poses)} objects placed, after {self.backtracks} backtracks); use fewer or "
             "smaller objects, a larger table, or a wider region")
 

@@ -6,6 +6,7 @@ from typing import Any
 
 import numpy as np
 
+from vcage.scene.layout import Region, ReservedZone
 from vcage.sim.world import World
 from vcage.skills.primitives import Skills
 from vcage.tasks import predicates as P
@@ -23,6 +24,9 @@ class BlocksRankingRGB(AtomicTask):
         "line up the red, green and blue blocks from left to right",
         "rank the blocks by colour: red, then green, then blue",
     )
+
+    # the target row stays free of clutter
+    reserved = (ReservedZone("row", Region((ROW_X, 0.0), (0.04, max(SLOTS_Y) + 0.04))),)
 
     def layout(self, rng: np.random.Generator) -> tuple[Item, ...]:
         # Shuffle which colour starts where, in a back row away from the target row.

@@ -6,6 +6,7 @@ from typing import Any
 
 import numpy as np
 
+from vcage.scene.layout import Region, Relation, ReservedZone
 from vcage.sim.world import World
 from vcage.skills.primitives import Skills
 from vcage.tasks import predicates as P
@@ -44,6 +45,13 @@ class PlaceA2B(AtomicTask):
         return {"success": beside and down, "beside": beside, "released_on_table": down}
 
 
+def target_zone(side: int) -> ReservedZone:
+    """Where A will be put: beside B's nominal position, widened by B's jitter."""
+    return ReservedZone("target", Region((0.58, side * SIDE_OFFSET), (0.06, 0.06)))
+
+
 @TASKS.register("place_a2b_left")
 class PlaceA2BLeft(PlaceA2B):
     side = 1
+    relations = (Relation("right_of", "a", "b", 0.1),)  # A starts on the other side
+    reserved = (target_zone(1),)
