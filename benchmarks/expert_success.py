@@ -14,7 +14,7 @@ import time
 from concurrent.futures import ProcessPoolExecutor
 
 from vcage.config import Randomization
-from vcage.errors import PlacementError, SimulationError
+from vcage.errors import PlacementError, SimulationError, UnstableSceneError
 from vcage.scene.placement import PLACERS
 from vcage.tasks.base import TASKS, SceneConfig
 from vcage.tasks.runner import make_task, run_episode
@@ -32,6 +32,8 @@ def _one(args: tuple[str, int, bool, SceneConfig]) -> tuple[str, bool, int, bool
         return task, randomized, seed, False, f"unstable: {exc}"
     except PlacementError as exc:
         return task, randomized, seed, False, f"placement: {exc}"
+    except UnstableSceneError as exc:
+        return task, randomized, seed, False, f"invalid scene: {exc}"
 
 
 def main() -> None:

@@ -33,6 +33,10 @@ class PlacementError(SceneError):
     """Objects cannot be placed as specified: a constraint is impossible or the free space ran out."""
 
 
+class UnstableSceneError(SceneError):
+    """An instantiated scene is not physically valid: objects interpenetrate, move or fall."""
+
+
 class SimulationError(VcageError):
     """The physics became unstable (NaN, exploding velocities); the episode must not be recorded."""
 

@@ -93,3 +93,15 @@ def test_naive_task_placement_is_available_for_comparison() -> None:
     assert task.placement_stats is not None and task.placement_stats.method == "naive"
     with pytest.raises(RegistryError, match="context, naive, rejection"):
         SceneConfig("magic")
+
+
+def test_invalid_task_scenes_are_rejected_with_the_reason() -> None:
+    from vcage.errors import UnstableSceneError
+    from vcage.tasks.base import SceneConfig
+    from vcage.tasks.runner import prepare
+
+    crowded = SceneConfig("naive", clutter=25)
+    with pytest.raises(UnstableSceneError, match="stack_blocks_two .*naive placement.*interpenetrating"):
+        prepare("stack_blocks_two", 0, Randomization(), scene=crowded)
+    # Vanilla mode skips the check: the same scene is built and settled without complaint
+    prepare("stack_blocks_two", 0, Randomization(), scene=SceneConfig("naive", clutter=25, check=False))

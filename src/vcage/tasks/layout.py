@@ -44,6 +44,7 @@ class SceneConfig:
 
     placement: str = DEFAULT_METHOD  # "context" | "naive" | "rejection"
     clutter: int = 0  # distractors added around the task's objects
+    check: bool = True  # verify the scene in physics before the expert runs (off for Vanilla)
     config: PlacementConfig = field(default_factory=PlacementConfig)
 
     def __post_init__(self) -> None:

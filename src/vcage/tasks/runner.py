@@ -8,9 +8,10 @@ from typing import Any
 import numpy as np
 
 from vcage.config import Randomization, SimConfig
-from vcage.errors import SkillError
+from vcage.errors import SkillError, UnstableSceneError
 from vcage.scene.compose import compose
 from vcage.scene.spec import SceneSpec
+from vcage.scene.stability import StabilityConfig, check_stability
 from vcage.sim.world import World
 from vcage.skills.executor import Recording
 from vcage.skills.primitives import Skills
@@ -41,12 +42,23 @@ def make_task(name: str) -> AtomicTask:
 
 def prepare(name: str, seed: int, rand: Randomization, sim: SimConfig = SimConfig(),
             scene: SceneConfig | None = None) -> tuple[AtomicTask, World, np.random.Generator]:
-    """Build and compose the task's scene for ``seed`` and let it settle."""
+    """Build and compose the task's scene for ``seed`` and let it settle.
+
+    Unless ``scene.check`` is off, the scene is checked while it settles and an invalid one
+    raises :class:`UnstableSceneError` with the reason.
+    """
     task = make_task(name)
     rng = np.random.default_rng(seed)
+    scene = scene or SceneConfig()
     spec = task.build(rng, rand, scene)
     world = compose(spec, sim).make_world(sim)
-    world.settle(SETTLE_SECONDS)
+    if scene.check:  # settles the world as it checks it
+        report = check_stability(world, StabilityConfig(settle_seconds=SETTLE_SECONDS))
+        if not report.ok:
+            raise UnstableSceneError(f"the scene of {name} (seed {seed}, {scene.placement} "
+                                     f"placement) is not physically valid: {report.reason()}")
+    else:
+        world.settle(SETTLE_SECONDS)
     task.setup(world)
     return task, world, rng
 
