@@ -55,3 +55,32 @@ class UnreachableError(SkillError):
 
 class TaskError(VcageError):
     """A task is misconfigured or its scene cannot be built."""
+
+
+class BackendError(VcageError):
+    """A model provider request failed (after any retries); says endpoint, model, status, what to check."""
+
+    def __init__(
+        self,
+        message: str,
+        *,
+        endpoint: str | None = None,
+        model: str | None = None,
+        status: int | None = None,
+    ) -> None:
+        super().__init__(message)
+        self.endpoint = endpoint
+        self.model = model
+        self.status = status
+
+
+class BackendTimeout(BackendError):  # noqa: N818 - the name says what happened
+    """A model provider did not answer within the configured timeout on any attempt."""
+
+
+class MissingAPIKeyError(ConfigError):
+    """No API key is configured for a remote endpoint; the message names the env var and config field."""
+
+
+class DatasetError(VcageError):
+    """A dataset cannot be written or read as asked: mismatched config, bad input or a corrupt file."""

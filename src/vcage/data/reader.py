@@ -1,0 +1,258 @@
+"""The LeRobot v3 layout (features, path templates) and a reader for datasets in it.
+
+``meta/info.json`` is the commit point: rows and files beyond its ``total_episodes`` are ignored.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pyarrow as pa
+import pyarrow.compute as pc
+import pyarrow.parquet as pq
+
+from vcage.data.video import decode_video
+from vcage.errors import DatasetError
+
+CODEBASE_VERSION = "v3.0"
+CHUNKS_SIZE = 1000
+DATA_PATH = "data/chunk-{chunk_index:03d}/file-{file_index:03d}.parquet"
+VIDEO_PATH = "videos/{video_key}/chunk-{chunk_index:03d}/file-{file_index:03d}.mp4"
+EPISODES_PATH = "meta/episodes/chunk-{chunk_index:03d}/file-{file_index:03d}.parquet"
+INFO_PATH = "meta/info.json"
+TASKS_PATH = "meta/tasks.parquet"
+STATS_PATH = "meta/stats.json"
+VCAGE_PATH = "meta/vcage.json"
+EXTRAS_PATH = "extras/episode_{episode_index:06d}.json"
+ARRAYS_PATH = "extras/episode_{episode_index:06d}_states.npz"
+DTYPES = {"float32": pa.float32(), "float64": pa.float64(), "int32": pa.int32(), "int64": pa.int64(),
+          "bool": pa.bool_()}
+# Columns every LeRobot frame row has, besides the features.
+STANDARD_COLUMNS = {"timestamp": "float32", "frame_index": "int64", "episode_index": "int64",
+                    "index": "int64", "task_index": "int64"}
+
+
+@dataclass(frozen=True)
+class Feature:
+    """A per-frame vector column: dtype (float32, float64, int32, int64, bool), shape (n,), optional names."""
+
+    dtype: str
+    shape: tuple[int, ...]
+    names: Sequence[str] | None = None
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "shape", tuple(int(s) for s in self.shape))
+        if self.names is not None:
+            object.__setattr__(self, "names", tuple(str(n) for n in self.names))
+        if self.dtype not in DTYPES:
+            raise DatasetError(f"feature dtype {self.dtype!r} is not supported; use one of "
+                               f"{', '.join(DTYPES)}")
+        if len(self.shape) != 1 or self.shape[0] < 1:
+            raise DatasetError(f"feature shape {self.shape} is not supported; use a 1-D shape (n,), n >= 1")
+        if self.names is not None and len(self.names) != self.shape[0]:
+            raise DatasetError(f"feature has {len(self.names)} names for shape {self.shape}; "
+                               "give one name per element")
+
+    def to_info(self) -> dict[str, Any]:
+        return {"dtype": self.dtype, "shape": list(self.shape),
+                "names": list(self.names) if self.names is not None else None}
+
+    @classmethod
+    def from_info(cls, info: dict[str, Any]) -> Feature:
+        names = info.get("names")
+        if isinstance(names, dict):  # LeRobot also allows {"motors": [...]}
+            lists = [v for v in names.values() if isinstance(v, list)]
+            names = lists[0] if len(lists) == 1 else None
+        return cls(str(info["dtype"]), tuple(info["shape"]), names)
+
+
+@dataclass(frozen=True, eq=False)
+class Episode:
+    """One episode: frames holds every data column, (T, n) for features and (T,) for the standard ones."""
+
+    index: int
+    task: str
+    length: int
+    frames: dict[str, np.ndarray]
+    extras: dict[str, Any]
+    arrays: dict[str, np.ndarray]
+
+
+def load_json(path: Path) -> Any:
+    """Parse a JSON file; missing or invalid files raise DatasetError naming the file."""
+    try:
+        return json.loads(path.read_text())
+    except FileNotFoundError:
+        raise DatasetError(f"{path} is missing; the dataset is incomplete or this is not a dataset") from None
+    except (OSError, ValueError) as exc:
+        raise DatasetError(f"{path} is not readable JSON: {exc}") from exc
+
+
+def read_parquet(path: Path) -> pa.Table:
+    """Read a parquet file; missing or unreadable files raise DatasetError naming the file."""
+    if not path.is_file():
+        raise DatasetError(f"{path} is missing; the dataset is incomplete")
+    try:
+        return pq.read_table(path)
+    except (OSError, pa.ArrowException) as exc:
+        raise DatasetError(f"{path} is not a readable parquet file: {exc}") from exc
+
+
+def column_to_numpy(column: pa.ChunkedArray | pa.Array) -> np.ndarray:
+    """A fixed-size list column as (T, n), a primitive column as (T,)."""
+    array = column.combine_chunks() if isinstance(column, pa.ChunkedArray) else column
+    if pa.types.is_fixed_size_list(array.type):
+        values = array.flatten().to_numpy(zero_copy_only=False)
+        return values.reshape(len(array), array.type.list_size)
+    if pa.types.is_list(array.type) or pa.types.is_large_list(array.type):
+        return np.asarray(array.to_pylist())
+    return array.to_numpy(zero_copy_only=False)
+
+
+class DatasetReader:
+    """Reads a LeRobot v3 dataset (vcage-written or any with the same layout) and vcage extras."""
+
+    def __init__(self, root: str | Path) -> None:
+        self.root = Path(root)
+        self.info: dict[str, Any] = load_json(self.root / INFO_PATH)
+        try:
+            self._parse_info()
+        except (KeyError, TypeError, ValueError) as exc:
+            raise DatasetError(f"{self.root / INFO_PATH} lacks or mangles a required key: {exc}") from exc
+        vcage = self.root / VCAGE_PATH
+        self.config: dict[str, Any] | None = load_json(vcage).get("config") if vcage.exists() else None
+        self._uncommitted = False  # meta rows beyond the commit point (left by a crash)
+        self.tasks: list[str] = self._read_tasks() if self.num_episodes else []
+        self._rows: list[dict[str, Any]] = self._read_episode_rows() if self.num_episodes else []
+        self._check_files()
+
+    def _parse_info(self) -> None:
+        info = self.info
+        if info["codebase_version"] != CODEBASE_VERSION:
+            raise DatasetError(f"{self.root / INFO_PATH}: codebase_version {info['codebase_version']!r} "
+                               f"is not {CODEBASE_VERSION!r}; only LeRobot v3 datasets are supported")
+        self.fps = int(info["fps"])
+        self.num_episodes = int(info["total_episodes"])
+        self.total_frames = int(info["total_frames"])
+        self.robot_type = info.get("robot_type")
+        self.features: dict[str, Feature] = {}
+        self.cameras: dict[str, tuple[int, int]] = {}
+        for key, ft in info["features"].items():
+            if ft["dtype"] == "video":
+                self.cameras[key] = (int(ft["shape"][0]), int(ft["shape"][1]))
+            elif key not in STANDARD_COLUMNS and ft["dtype"] in DTYPES and len(ft["shape"]) == 1:
+                self.features[key] = Feature.from_info(ft)
+
+    def _read_tasks(self) -> list[str]:
+        path = self.root / TASKS_PATH
+        table = read_parquet(path)
+        if "task" not in table.column_names or "task_index" not in table.column_names:
+            raise DatasetError(f"{path} needs columns 'task' and 'task_index', has {table.column_names}")
+        by_index = dict(zip(table.column("task_index").to_pylist(), table.column("task").to_pylist(),
+                            strict=True))
+        total = int(self.info.get("total_tasks", len(by_index)))
+        self._uncommitted |= len(by_index) > total
+        if sorted(by_index)[:total] != list(range(total)):
+            raise DatasetError(f"{path} does not hold task indices 0..{total - 1} that {INFO_PATH} declares")
+        return [by_index[i] for i in range(total)]
+
+    def _read_episode_rows(self) -> list[dict[str, Any]]:
+        files = sorted((self.root / "meta" / "episodes").glob("chunk-*/file-*.parquet"))
+        rows: dict[int, dict[str, Any]] = {}
+        for path in files:
+            for row in read_parquet(path).to_pylist():
+                if row["episode_index"] < self.num_episodes:
+                    rows[int(row["episode_index"])] = row
+                else:
+                    self._uncommitted = True
+        if len(rows) != self.num_episodes:
+            where = ", ".join(str(p.relative_to(self.root)) for p in files) or "meta/episodes/ (no files)"
+            raise DatasetError(f"episode count mismatch: {self.root / INFO_PATH} says {self.num_episodes} "
+                               f"episodes but {where} describe {len(rows)} of them; the dataset is corrupt")
+        ordered = [rows[i] for i in range(self.num_episodes)]
+        total = sum(int(r["length"]) for r in ordered)
+        if total != self.total_frames:
+            raise DatasetError(f"{self.root / INFO_PATH} says {self.total_frames} frames but the episodes "
+                               f"add up to {total}; the dataset is corrupt")
+        return ordered
+
+    def _check_files(self) -> None:
+        for i in range(self.num_episodes):
+            paths = [self.data_path(i)] + [self.video_path(i, key) for key in self.cameras]
+            for path in paths:
+                if not path.is_file():
+                    raise DatasetError(f"{path} (episode {i}) is missing; the dataset is corrupt")
+
+    def __len__(self) -> int:
+        return self.num_episodes
+
+    def episode_meta(self, index: int) -> dict[str, Any]:
+        """The row of ``meta/episodes`` for an episode (offsets, lengths, per-episode stats)."""
+        if not 0 <= index < self.num_episodes:
+            raise DatasetError(f"episode {index} does not exist; the dataset has {self.num_episodes} "
+                               "episodes")
+        return self._rows[index]
+
+    def data_path(self, index: int) -> Path:
+        row = self.episode_meta(index)
+        return self.root / self.info["data_path"].format(
+            chunk_index=row["data/chunk_index"], file_index=row["data/file_index"])
+
+    def video_path(self, index: int, key: str) -> Path:
+        if key not in self.cameras:
+            raise DatasetError(f"unknown camera {key!r}; the dataset has {sorted(self.cameras)}")
+        row = self.episode_meta(index)
+        return self.root / self.info["video_path"].format(
+            video_key=key, chunk_index=row[f"videos/{key}/chunk_index"],
+            file_index=row[f"videos/{key}/file_index"])
+
+    def episode(self, index: int) -> Episode:
+        """Frames, task, extras and arrays of one episode (videos are read with :meth:`video`)."""
+        row = self.episode_meta(index)
+        path = self.data_path(index)
+        table = read_parquet(path)
+        if "episode_index" not in table.column_names:
+            raise DatasetError(f"{path} has no 'episode_index' column; the dataset is corrupt")
+        table = table.filter(pc.equal(table.column("episode_index"), index))
+        if table.num_rows != row["length"]:
+            raise DatasetError(f"{path} holds {table.num_rows} frames of episode {index}, "
+                               f"meta/episodes says {row['length']}; the dataset is corrupt")
+        frames = {name: column_to_numpy(table.column(name)) for name in table.column_names}
+        for name, feature in self.features.items():
+            if name in frames and frames[name].ndim == 1:
+                frames[name] = frames[name].reshape(-1, *feature.shape)
+        tasks = row.get("tasks") or []
+        return Episode(index, str(tasks[0]) if tasks else "", int(row["length"]), frames,
+                       self.extras(index), self.arrays(index))
+
+    def extras(self, index: int) -> dict[str, Any]:
+        path = self.root / EXTRAS_PATH.format(episode_index=index)
+        return dict(load_json(path)) if path.exists() else {}
+
+    def arrays(self, index: int) -> dict[str, np.ndarray]:
+        path = self.root / ARRAYS_PATH.format(episode_index=index)
+        if not path.exists():
+            return {}
+        try:
+            with np.load(path, allow_pickle=False) as npz:
+                return {key: npz[key] for key in npz.files}
+        except (OSError, ValueError) as exc:
+            raise DatasetError(f"{path} is not a readable npz file: {exc}") from exc
+
+    def video(self, index: int, key: str) -> np.ndarray:
+        """Decoded frames (T, H, W, 3) uint8 of one camera for one episode."""
+        path = self.video_path(index, key)
+        row = self.episode_meta(index)
+        frames, times = decode_video(path)
+        half = 0.5 / self.fps
+        start, stop = float(row[f"videos/{key}/from_timestamp"]), float(row[f"videos/{key}/to_timestamp"])
+        keep = (times >= start - half) & (times < stop - half)
+        if int(keep.sum()) != row["length"]:
+            raise DatasetError(f"{path} holds {int(keep.sum())} frames for episode {index}, "
+                               f"expected {row['length']}; the dataset is corrupt")
+        return frames[keep]
