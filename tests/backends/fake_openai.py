@@ -1,0 +1,205 @@
+"""A local HTTP server speaking OpenAI's chat-completions protocol, driven by a script.
+
+Use from any test (``tests/`` is on ``sys.path`` through ``tests/conftest.py``)::
+
+    from backends.fake_openai import FakeOpenAI, Reply, Status, Delay
+
+    with FakeOpenAI() as server:
+        server.script("first reply", Status(429, retry_after="0.1"), Reply('{"ok": true}'))
+        cfg = BackendConfig(base_url=server.base_url, model="m")
+        ...
+        server.requests  # every request body received, parsed JSON, in order
+
+Each ``POST /v1/chat/completions`` consumes the next scripted item: a reply text (``str`` or
+:class:`Reply`), an HTTP error in OpenAI's error format (:class:`Status`), a :class:`Delay` (sleep,
+then answer with its ``then`` item, usually after the client gave up), or a callable that receives the
+request body and returns one of those. An empty script answers 500 with a message saying so.
+``GET /v1/models`` lists the served model.
+"""
+
+from __future__ import annotations
+
+import json
+import threading
+import time
+import uuid
+from collections import deque
+from collections.abc import Callable
+from dataclasses import dataclass
+from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
+from typing import Any
+
+ERROR_TYPES = {400: "invalid_request_error", 401: "authentication_error", 403: "permission_error",
+               404: "not_found_error", 429: "rate_limit_error"}
+
+
+@dataclass(frozen=True)
+class Reply:
+    """A successful completion; ``text=None`` sends a message without content."""
+
+    text: str | None
+    finish_reason: str = "stop"
+    prompt_tokens: int = 11
+    completion_tokens: int = 7
+
+
+@dataclass(frozen=True)
+class Status:
+    """An HTTP error with an OpenAI-format body and optional ``Retry-After`` / ``retry-after-ms``."""
+
+    status: int
+    message: str = "scripted error"
+    retry_after: str | None = None
+    retry_after_ms: str | None = None
+
+
+@dataclass(frozen=True)
+class Delay:
+    """Sleep ``seconds`` (cut short when the server closes), then answer with ``then``."""
+
+    seconds: float
+    then: Reply | Status | str = "late reply"
+
+
+Item = str | Reply | Status | Delay | Callable[[dict[str, Any]], "str | Reply | Status | Delay"]
+
+
+class FakeOpenAI:
+    """A scripted OpenAI-compatible server on 127.0.0.1 and a free port, in a background thread."""
+
+    def __init__(self, model: str = "fake-model") -> None:
+        self.model = model
+        self.requests: list[dict[str, Any]] = []  # request bodies, in arrival order
+        self.headers: list[dict[str, str]] = []  # request headers, same order
+        self._script: deque[Item] = deque()
+        self._lock = threading.Lock()
+        self._closing = threading.Event()
+        self._httpd = ThreadingHTTPServer(("127.0.0.1", 0), _handler_class(self))
+        self._httpd.daemon_threads = True
+        self._thread = threading.Thread(
+            target=self._httpd.serve_forever, kwargs={"poll_interval": 0.02}, name="FakeOpenAI", daemon=True
+        )
+
+    @property
+    def base_url(self) -> str:
+        host, port = self._httpd.server_address[:2]
+        return f"http://{host!s}:{port}/v1"
+
+    def script(self, *items: Item) -> FakeOpenAI:
+        """Queue responses, one per expected chat request."""
+        with self._lock:
+            self._script.extend(items)
+        return self
+
+    @property
+    def remaining(self) -> int:
+        with self._lock:
+            return len(self._script)
+
+    def start(self) -> FakeOpenAI:
+        self._thread.start()
+        return self
+
+    def close(self) -> None:
+        self._closing.set()
+        self._httpd.shutdown()
+        self._httpd.server_close()
+        self._thread.join(timeout=5)
+
+    def __enter__(self) -> FakeOpenAI:
+        return self.start()
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    def _next(self, body: dict[str, Any], headers: dict[str, str]) -> Item | None:
+        with self._lock:
+            self.requests.append(body)
+            self.headers.append(headers)
+            return self._script.popleft() if self._script else None
+
+    def _sleep(self, seconds: float) -> None:
+        self._closing.wait(seconds)
+
+
+def completion(model: str, reply: Reply) -> dict[str, Any]:
+    """A chat.completion object in OpenAI's response schema."""
+    return {
+        "id": f"chatcmpl-{uuid.uuid4().hex[:12]}",
+        "object": "chat.completion",
+        "created": int(time.time()),
+        "model": model,
+        "choices": [{"index": 0, "message": {"role": "assistant", "content": reply.text},
+                     "finish_reason": reply.finish_reason}],
+        "usage": {"prompt_tokens": reply.prompt_tokens, "completion_tokens": reply.completion_tokens,
+                  "total_tokens": reply.prompt_tokens + reply.completion_tokens},
+    }
+
+
+def error_body(status: int, message: str) -> dict[str, Any]:
+    """An error object in OpenAI's format."""
+    kind = ERROR_TYPES.get(status, "server_error" if status >= 500 else "invalid_request_error")
+    return {"error": {"message": message, "type": kind, "param": None, "code": str(status)}}
+
+
+def _handler_class(server: FakeOpenAI) -> type[BaseHTTPRequestHandler]:
+    class Handler(BaseHTTPRequestHandler):
+        protocol_version = "HTTP/1.1"
+
+        def log_message(self, format: str, *args: Any) -> None:  # keep test output quiet
+            pass
+
+        def do_GET(self) -> None:  # noqa: N802 - http.server naming
+            if self.path.rstrip("/") == "/v1/models":
+                data = [{"id": server.model, "object": "model", "created": 0, "owned_by": "fake-openai"}]
+                self._send(200, {"object": "list", "data": data})
+            else:
+                self._send(404, error_body(404, f"no route GET {self.path}"))
+
+        def do_POST(self) -> None:  # noqa: N802 - http.server naming
+            raw = self.rfile.read(int(self.headers.get("Content-Length") or 0))
+            if self.path.rstrip("/") != "/v1/chat/completions":
+                self._send(404, error_body(404, f"no route POST {self.path}"))
+                return
+            try:
+                body = json.loads(raw)
+            except ValueError:
+                self._send(400, error_body(400, "request body is not valid JSON"))
+                return
+            item = server._next(body, {k.lower(): v for k, v in self.headers.items()})
+            self._answer(item, body)
+
+        def _answer(self, item: Item | None, body: dict[str, Any]) -> None:
+            if item is None:
+                n = len(server.requests)
+                msg = f"FakeOpenAI: script is empty at request #{n}; script one response per expected request"
+                self._send(500, error_body(500, msg))
+            elif isinstance(item, Delay):
+                server._sleep(item.seconds)
+                self._answer(item.then, body)
+            elif isinstance(item, Status):
+                headers = {"Retry-After": item.retry_after, "retry-after-ms": item.retry_after_ms}
+                self._send(item.status, error_body(item.status, item.message), headers)
+            elif isinstance(item, (str, Reply)):
+                reply = Reply(item) if isinstance(item, str) else item
+                self._send(200, completion(str(body.get("model", server.model)), reply))
+            else:
+                self._answer(item(body), body)
+
+        def _send(
+            self, status: int, payload: dict[str, Any], headers: dict[str, str | None] | None = None
+        ) -> None:
+            data = json.dumps(payload).encode()
+            try:
+                self.send_response(status)
+                self.send_header("Content-Type", "application/json")
+                self.send_header("Content-Length", str(len(data)))
+                for key, value in (headers or {}).items():
+                    if value is not None:
+                        self.send_header(key, value)
+                self.end_headers()
+                self.wfile.write(data)
+            except (BrokenPipeError, ConnectionResetError):
+                pass  # the client gave up (timeout) before the answer
+
+    return Handler
