@@ -84,3 +84,7 @@ class MissingAPIKeyError(ConfigError):
 
 class DatasetError(VcageError):
     """A dataset cannot be written or read as asked: mismatched config, bad input or a corrupt file."""
+
+
+class PlanningError(VcageError):
+    """An instruction cannot be grounded into a valid plan; the message says what the planner can do."""

@@ -180,11 +180,13 @@ def move_to(s: Skills, pos: np.ndarray, yaw: float | None = None, gripper: float
 
 @SKILLS.register("open_gripper")
 def open_gripper(s: Skills) -> MotionPlan:
+    """Open the hand fully where it is."""
     return MotionPlan("open_gripper", (Waypoint(s.q, OPEN, 0.3, hold=0.3, label="open"),))
 
 
 @SKILLS.register("close_gripper")
 def close_gripper(s: Skills) -> MotionPlan:
+    """Close the hand where it is."""
     return MotionPlan("close_gripper", (Waypoint(s.q, CLOSED, 0.3, hold=0.5, label="close"),))
 
 
@@ -198,6 +200,7 @@ def grasp(s: Skills, obj: str, grasp_name: str | None = None) -> MotionPlan:
 
 @SKILLS.register("lift")
 def lift(s: Skills, height: float = 0.12) -> MotionPlan:
+    """Raise the hand (and whatever it holds) straight up to ``height`` above the table."""
     pos, yaw = s.tcp()
     target = np.array([pos[0], pos[1], max(pos[2], s.table_z) + height])
     return MotionPlan("lift", tuple(s.line(s.q, target, yaw, s.gripper, SLOW_SPEED, "lift")))

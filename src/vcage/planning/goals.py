@@ -1,0 +1,144 @@
+"""The offline planner's library of long-horizon goals, each 3 to 6 subtasks of verified skills.
+
+A goal is data: the phrasings it answers to (for paraphrase matching), its objects and its
+subtasks. Subtasks reuse the skills and success predicates of the atomic tasks (put on, put in,
+press, arrange by position), so every goal is built from parts whose experts are measured.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+from vcage.planning.schema import Plan, PlanObject, PlanRelation, Predicate, Subtask
+
+
+@dataclass(frozen=True)
+class Goal:
+    name: str
+    phrasings: tuple[str, ...]
+    objects: tuple[PlanObject, ...]
+    subtasks: tuple[Subtask, ...]
+    relations: tuple[PlanRelation, ...] = ()
+
+    def plan(self, instruction: str) -> Plan:
+        return Plan(instruction=instruction, goal=self.name, objects=self.objects,
+                    relations=self.relations, subtasks=self.subtasks)
+
+
+def _obj(name: str, type_: str, color: str | None = None) -> PlanObject:
+    return PlanObject(name=name, type=type_, color=color)
+
+
+def put_on(obj: str, target: str, text: str) -> Subtask:
+    return Subtask(skill="pick_and_place", args={"obj": obj, "target": target}, description=text,
+                   predicates=(Predicate(name="on", args=(obj, target)),
+                               Predicate(name="released", args=(obj,))))
+
+
+def put_in(obj: str, target: str, text: str) -> Subtask:
+    return Subtask(skill="pick_and_place", args={"obj": obj, "target": target}, description=text,
+                   predicates=(Predicate(name="inside", args=(obj, target)),
+                               Predicate(name="released", args=(obj,))))
+
+
+def press(obj: str, text: str, point: str | None = None) -> Subtask:
+    args: dict[str, Any] = {"obj": obj} if point is None else {"obj": obj, "point": point}
+    return Subtask(skill="press", args=args, description=text,
+                   predicates=(Predicate(name="pressed", args=(obj,)),
+                               Predicate(name="upright", args=(obj,))))
+
+
+def put_at(obj: str, xy: tuple[float, float], text: str, left_of: str | None = None) -> Subtask:
+    preds = [Predicate(name="on_table", args=(obj,)), Predicate(name="released", args=(obj,))]
+    if left_of is not None:
+        preds.append(Predicate(name="left_of", args=(obj, left_of)))
+    return Subtask(skill="pick_and_place", args={"obj": obj, "xy": list(xy)}, description=text,
+                   predicates=tuple(preds))
+
+
+ROW_X = 0.42  # where arranged objects are lined up (as in blocks_ranking_rgb)
+
+GOALS: tuple[Goal, ...] = (
+    Goal("get_ready_for_work",
+         ("get ready for work", "prepare my desk for the work day", "set up my workspace",
+          "get my desk ready for the morning"),
+         (_obj("phone", "phone"), _obj("stand", "phone_stand"), _obj("mouse", "mouse"),
+          _obj("pad", "mouse_pad"), _obj("clock", "alarm_clock")),
+         (press("clock", "the alarm clock's button is pressed to silence it"),
+          put_on("phone", "stand", "the phone rests on the phone stand"),
+          put_on("mouse", "pad", "the mouse lies on the mouse pad"))),
+    Goal("prepare_breakfast",
+         ("prepare breakfast", "make breakfast", "get breakfast ready", "fix me some breakfast"),
+         (_obj("bread", "bread"), _obj("basket", "basket"), _obj("cup", "cup"),
+          _obj("coaster", "coaster"), _obj("bell", "bell")),
+         (put_in("bread", "basket", "the bread is in the basket"),
+          put_on("cup", "coaster", "the cup stands on the coaster"),
+          press("bell", "the bell is rung to call for breakfast"))),
+    Goal("tidy_the_desk",
+         ("tidy the desk", "clean up the desk", "organise my desk", "declutter the workspace"),
+         (_obj("phone", "phone"), _obj("stand", "phone_stand"), _obj("mouse", "mouse"),
+          _obj("pad", "mouse_pad"), _obj("seal", "seal"), _obj("mat", "stamp_mat")),
+         (put_on("phone", "stand", "the phone rests on the phone stand"),
+          put_on("mouse", "pad", "the mouse lies on the mouse pad"),
+          put_on("seal", "mat", "the seal stands on its mat"))),
+    Goal("set_the_table",
+         ("set the table", "lay the table", "get the table ready for a meal", "prepare the table for dinner"),
+         (_obj("cup", "cup"), _obj("coaster", "coaster"), _obj("bread", "bread"),
+          _obj("basket", "basket"), _obj("bell", "bell")),
+         (put_on("cup", "coaster", "the cup stands on the coaster"),
+          put_in("bread", "basket", "the bread is in the basket"),
+          press("bell", "the bell is rung to announce the meal"))),
+    Goal("sort_blocks_by_colour",
+         ("sort the blocks by colour", "sort blocks by color", "arrange the blocks red green blue",
+          "order the blocks by colour from left to right"),
+         (_obj("red", "block", "red"), _obj("green", "block", "green"), _obj("blue", "block", "blue")),
+         (put_at("red", (ROW_X, 0.12), "the red block is at the left end of the row"),
+          put_at("green", (ROW_X, 0.0), "the green block is right of the red block", left_of=None),
+          put_at("blue", (ROW_X, -0.12), "the blue block is at the right end of the row"))),
+    Goal("build_a_tower",
+         ("build a tower", "stack the blocks into a tower", "make a tower of blocks",
+          "pile the blocks up"),
+         (_obj("base", "block", "red"), _obj("middle", "block", "green"), _obj("top", "block", "blue"),
+          _obj("bell", "bell")),
+         (put_on("middle", "base", "the green block is stacked on the red block"),
+          put_on("top", "middle", "the blue block is stacked on the green block"),
+          press("bell", "the bell is rung to show the tower is done"))),
+    Goal("do_the_paperwork",
+         ("do the paperwork", "finish the office work", "handle the paperwork",
+          "stamp and staple the documents"),
+         (_obj("seal", "seal"), _obj("mat", "stamp_mat"), _obj("stapler", "stapler"),
+          _obj("mouse", "mouse"), _obj("pad", "mouse_pad")),
+         (put_on("seal", "mat", "the seal is stamped onto the mat"),
+          press("stapler", "the stapler is pressed down"),
+          put_on("mouse", "pad", "the mouse lies on the mouse pad"))),
+    Goal("shut_down_for_the_night",
+         ("shut down for the night", "turn everything off", "switch things off before leaving",
+          "close up the office"),
+         (_obj("switch", "switch"), _obj("clock", "alarm_clock"), _obj("phone", "phone"),
+          _obj("stand", "phone_stand")),
+         (press("switch", "the switch is flipped", point="on"),
+          press("clock", "the alarm clock's button is pressed"),
+          put_on("phone", "stand", "the phone is put on its stand to charge"))),
+    Goal("display_the_fruit",
+         ("display the fruit", "show off the fruit", "put the fruit on display", "arrange the fruit nicely"),
+         (_obj("apple", "apple"), _obj("stand", "object_stand"), _obj("orange", "orange"),
+          _obj("plate", "plate"), _obj("bread", "bread"), _obj("basket", "basket")),
+         (put_on("apple", "stand", "the apple sits on the display stand"),
+          put_on("orange", "plate", "the orange lies on the plate"),
+          put_in("bread", "basket", "the bread is in the basket"))),
+    Goal("serve_tea",
+         ("serve tea", "serve a drink", "bring the tea", "get a drink ready"),
+         (_obj("cup", "cup"), _obj("coaster", "coaster"), _obj("bowl", "bowl"), _obj("plate", "plate"),
+          _obj("bell", "bell")),
+         (put_on("cup", "coaster", "the cup stands on the coaster"),
+          put_on("bowl", "plate", "the bowl stands on the plate"),
+          press("bell", "the bell is rung to call for tea"))),
+    Goal("tidy_the_kitchen",
+         ("tidy the kitchen", "clear away the dishes", "stack the dishes", "clean up the kitchen counter"),
+         (PlanObject(name="small", type="bowl", scale=0.85), _obj("large", "bowl"), _obj("cup", "cup"),
+          _obj("coaster", "coaster"), _obj("bread", "bread"), _obj("basket", "basket")),
+         (put_in("small", "large", "the smaller bowl is nested inside the larger one"),
+          put_on("cup", "coaster", "the cup stands on the coaster"),
+          put_in("bread", "basket", "the bread is put away in the basket"))),
+)

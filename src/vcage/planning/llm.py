@@ -1,0 +1,112 @@
+"""The LLM planner: any OpenAI-compatible chat model grounds the instruction into a ``Plan``.
+
+The prompt gives the skill library, the predicates, the catalog and the plan schema with one
+worked example. The reply must be JSON that validates as a :class:`Plan`; an invalid reply is sent
+back with the validation errors, a bounded number of times, then :class:`PlanningError` is raised.
+"""
+
+from __future__ import annotations
+
+import inspect
+import json
+import re
+
+from pydantic import ValidationError
+
+from vcage.assets.catalog import CATALOG
+from vcage.backends import ChatBackend, Message
+from vcage.errors import PlanningError
+from vcage.planning.goals import GOALS
+from vcage.planning.schema import PLAN_SKILLS, PREDICATES, Plan
+from vcage.skills.primitives import SKILLS
+
+MAX_REPAIRS = 2
+
+
+def skill_library() -> str:
+    lines = []
+    for name in PLAN_SKILLS:
+        fn = SKILLS.get(name)
+        params = [p for p in inspect.signature(fn).parameters.values() if p.name != "s"]
+        sig = ", ".join(p.name if p.default is inspect.Parameter.empty else f"{p.name}={p.default!r}"
+                        for p in params)
+        doc = (inspect.getdoc(fn) or "").split("\n")[0]
+        lines.append(f"- {name}({sig}): {doc}")
+    return "\n".join(lines)
+
+
+def catalog_lines() -> str:
+    lines = []
+    for t in CATALOG.all():
+        holds = ", ".join(f"{p.kind} '{p.name}'" for p in t.placements)
+        points = ", ".join(f.name for f in t.functional_points if f.joint)
+        extra = (f"; holds objects {holds}" if holds else "") + (f"; pressable at {points}" if points else "")
+        lines.append(f"- {t.name} ({t.category}): {t.description}; colours {', '.join(t.colors)}{extra}")
+    return "\n".join(lines)
+
+
+def system_prompt() -> str:
+    example = GOALS[0].plan(GOALS[0].phrasings[0]).model_dump(mode="json", exclude_none=True)
+    preds = ", ".join(f"{n}({lo}..{hi} objects)" for n, (lo, hi) in PREDICATES.items())
+    return (
+        "You plan tabletop manipulation for a Franka Panda arm. Turn the user's instruction into a "
+        "JSON plan: the objects the scene needs (catalog types only, each with a unique name; `on` "
+        "names an object it starts on), optional relations between them for the initial layout, and "
+        "an ordered list of 1 to 6 subtasks. Each subtask calls one skill with arguments that name "
+        "plan objects, says in one sentence what must be visibly true afterwards, and lists the "
+        "predicates that define its success.\n\n"
+        f"Skills:\n{skill_library()}\n\nPredicates: {preds}. 'released(x)': the hand no longer holds "
+        "x; 'pressed(x)': x's button or lever was pressed during the subtask.\n\n"
+        f"Catalog:\n{catalog_lines()}\n\n"
+        f"JSON schema of the reply:\n{json.dumps(Plan.model_json_schema(), separators=(',', ':'))}\n\n"
+        f"Example for '{example['instruction']}':\n{json.dumps(example, separators=(',', ':'))}\n\n"
+        "Reply with the JSON object only."
+    )
+
+
+class LLMPlanner:
+    name = "llm"
+
+    def __init__(self, backend: ChatBackend, max_repairs: int = MAX_REPAIRS) -> None:
+        self.backend = backend
+        self.max_repairs = max_repairs
+
+    def plan(self, instruction: str) -> Plan:
+        text = " ".join(instruction.split())
+        if not re.search(r"[A-Za-z]{2,}", text):
+            raise PlanningError(f"empty or unintelligible instruction {instruction!r}: say what the "
+                                "robot should do, e.g. 'put the mouse on the mouse pad'")
+        messages = [Message("system", system_prompt()), Message("user", text)]
+        errors = ""
+        for _ in range(self.max_repairs + 1):
+            reply = self.backend.chat(messages, json_mode=True)
+            try:
+                data = json.loads(_strip_fences(reply))
+                if not isinstance(data, dict):
+                    raise ValueError(f"the reply is a JSON {type(data).__name__}, not an object")
+                data["instruction"] = text
+                data.setdefault("goal", None)
+                return Plan.model_validate(data)
+            except (ValueError, ValidationError) as exc:
+                errors = _describe(exc)
+            messages += [Message("assistant", reply),
+                         Message("user", f"That reply is not a valid plan: {errors}\nReply again with "
+                                         "only the corrected JSON object.")]
+        raise PlanningError(
+            f"the LLM planner gave no valid plan for {text!r} after {self.max_repairs + 1} replies; "
+            f"last problems: {errors}. Try a stronger model, or the offline planner's goals "
+            "(`vcage tasks`)")
+
+
+def _strip_fences(text: str) -> str:
+    m = re.search(r"```(?:json)?\s*(.*?)```", text, re.S)
+    return m.group(1) if m else text.strip()
+
+
+def _describe(exc: Exception) -> str:
+    if isinstance(exc, ValidationError):
+        return "; ".join(f"{'.'.join(str(p) for p in e['loc']) or 'plan'}: {e['msg']}"
+                         for e in exc.errors()[:8])
+    if isinstance(exc, json.JSONDecodeError):
+        return f"not valid JSON ({exc.msg} at line {exc.lineno} column {exc.colno})"
+    return str(exc)

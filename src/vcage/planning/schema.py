@@ -1,0 +1,151 @@
+"""The ``Plan``: what an instruction grounds to, validated the same way for every planner.
+
+A plan names the objects of the scene (catalog types, optionally standing on another object),
+relations for their initial layout, and an ordered list of subtasks. Each subtask is one skill
+call with arguments, a short description (what a critic is asked about) and the ground-truth
+predicates that define its success (what the oracle checks).
+"""
+
+from __future__ import annotations
+
+import inspect
+from typing import Any, Literal
+
+from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
+
+from vcage.assets.catalog import CATALOG
+from vcage.skills.primitives import SKILLS
+
+# predicate name -> (minimum, maximum) number of object arguments
+PREDICATES: dict[str, tuple[int, int]] = {
+    "on": (2, 2), "inside": (2, 2), "stacked": (2, 4), "near": (2, 2), "left_of": (2, 2),
+    "right_of": (2, 2), "on_table": (1, 1), "upright": (1, 1), "lifted": (1, 1),
+    "released": (1, 1), "pressed": (1, 1),
+}
+# skill arguments that name objects of the plan
+OBJECT_ARGS = ("obj", "target")
+# skills a plan may use (the composite ones a planner needs; the rest are building blocks)
+PLAN_SKILLS = ("pick_and_place", "press", "push", "lift", "grasp", "retreat", "open_gripper")
+
+
+class _Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+class PlanObject(_Strict):
+    name: str = Field(min_length=1, pattern=r"^[A-Za-z0-9_]+$")
+    type: str
+    color: str | None = None
+    scale: float | None = Field(default=None, ge=0.5, le=1.5)  # None: drawn from the type's range
+    on: str | None = None  # name of the object it starts on or in (None: the table)
+
+    @field_validator("type")
+    @classmethod
+    def _known_type(cls, v: str) -> str:
+        if v not in CATALOG:
+            raise ValueError(f"unknown object type {v!r}; catalog types: {', '.join(CATALOG.names())}")
+        return v
+
+    @model_validator(mode="after")
+    def _known_color(self) -> PlanObject:
+        if self.color is not None and self.color not in CATALOG.get(self.type).colors:
+            raise ValueError(f"{self.type} has no colour {self.color!r}; "
+                             f"variants: {sorted(CATALOG.get(self.type).colors)}")
+        return self
+
+
+class PlanRelation(_Strict):
+    kind: Literal["left_of", "right_of", "near", "far_from"]
+    a: str
+    b: str
+    distance: float = Field(default=0.05, ge=0.0, le=1.0)
+
+
+class Predicate(_Strict):
+    name: str
+    args: tuple[str, ...]
+
+    @model_validator(mode="after")
+    def _arity(self) -> Predicate:
+        if self.name not in PREDICATES:
+            raise ValueError(f"unknown predicate {self.name!r}; valid: {', '.join(PREDICATES)}")
+        lo, hi = PREDICATES[self.name]
+        if not lo <= len(self.args) <= hi:
+            raise ValueError(f"predicate {self.name} takes {lo}..{hi} objects, got {list(self.args)}")
+        return self
+
+    def __str__(self) -> str:
+        return f"{self.name}({', '.join(self.args)})"
+
+
+class Subtask(_Strict):
+    skill: str
+    args: dict[str, Any] = Field(default_factory=dict)
+    description: str = Field(min_length=3)
+    predicates: tuple[Predicate, ...] = ()
+
+    @model_validator(mode="after")
+    def _skill_signature(self) -> Subtask:
+        if self.skill not in PLAN_SKILLS:
+            raise ValueError(f"unknown skill {self.skill!r}; valid: {', '.join(PLAN_SKILLS)}")
+        params = inspect.signature(SKILLS.get(self.skill)).parameters
+        names = [p for p in params if p != "s"]
+        extra = set(self.args) - set(names)
+        if extra:
+            raise ValueError(f"skill {self.skill} has no argument(s) {sorted(extra)}; it takes {names}")
+        missing = [p for p, v in params.items() if p != "s" and v.default is inspect.Parameter.empty
+                   and p not in self.args]
+        if missing:
+            raise ValueError(f"skill {self.skill} needs argument(s) {missing}")
+        return self
+
+    def objects(self) -> list[str]:
+        named = [self.args[k] for k in OBJECT_ARGS if isinstance(self.args.get(k), str)]
+        return named + [a for p in self.predicates for a in p.args]
+
+
+class Plan(_Strict):
+    instruction: str = Field(min_length=1)
+    goal: str | None = None  # the library goal it was matched to, if any
+    objects: tuple[PlanObject, ...] = Field(min_length=1)
+    relations: tuple[PlanRelation, ...] = ()
+    subtasks: tuple[Subtask, ...] = Field(min_length=1)
+
+    @model_validator(mode="after")
+    def _references(self) -> Plan:
+        names = [o.name for o in self.objects]
+        if len(set(names)) != len(names):
+            raise ValueError(f"object names must be unique: {names}")
+        known = set(names)
+        for o in self.objects:
+            if o.on is not None and o.on not in known:
+                raise ValueError(f"object {o.name!r} starts on unknown object {o.on!r}")
+        for r in self.relations:
+            for n in (r.a, r.b):
+                if n not in known:
+                    raise ValueError(f"relation {r.kind}({r.a}, {r.b}) names unknown object {n!r}")
+        for i, st in enumerate(self.subtasks):
+            unknown = [n for n in st.objects() if n not in known]
+            if unknown:
+                raise ValueError(f"subtask {i} ({st.skill}) names unknown object(s) {unknown}; "
+                                 f"plan objects: {names}")
+        return self
+
+    def object(self, name: str) -> PlanObject:
+        return next(o for o in self.objects if o.name == name)
+
+    def summary(self) -> str:
+        lines = [f"instruction: {self.instruction}" + (f"  (goal: {self.goal})" if self.goal else "")]
+        lines.append("objects: " + ", ".join(
+            f"{o.name} ({(o.color + ' ') if o.color else ''}{o.type}{', on ' + o.on if o.on else ''})"
+            for o in self.objects))
+        for i, st in enumerate(self.subtasks, 1):
+            args = ", ".join(f"{k}={v}" for k, v in st.args.items())
+            preds = ", ".join(str(p) for p in st.predicates)
+            lines.append(f"{i}. {st.skill}({args}): {st.description}  [{preds}]")
+        return "\n".join(lines)
+
+
+def plan_json_schema() -> dict[str, Any]:
+    """The JSON schema an LLM planner is asked to follow."""
+    return Plan.model_json_schema()

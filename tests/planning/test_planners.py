@@ -1,0 +1,150 @@
+"""Offline planner (sequences, goal paraphrases, refusals) and the LLM planner over real HTTP."""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Iterator
+
+import pytest
+
+from backends.fake_openai import Delay, FakeOpenAI
+from vcage.backends import BackendConfig, make_backend
+from vcage.errors import BackendTimeout, ConfigError, PlanningError
+from vcage.planning import PLANNERS, LLMPlanner, OfflinePlanner, make_planner
+from vcage.planning.goals import GOALS
+from vcage.planning.schema import Plan
+
+OFFLINE = OfflinePlanner()
+
+
+def test_goal_library_has_ten_goals_of_three_to_six_subtasks() -> None:
+    assert len(GOALS) >= 10
+    for goal in GOALS:
+        plan = goal.plan(goal.phrasings[0])
+        assert 3 <= len(plan.subtasks) <= 6, goal.name
+        assert all(st.predicates for st in plan.subtasks)
+
+
+@pytest.mark.parametrize("text, goal", [
+    ("get ready for work", "get_ready_for_work"),
+    ("could you get my workspace ready for the day", "get_ready_for_work"),
+    ("I would like breakfast", "prepare_breakfast"),
+    ("clean up my office", "tidy_the_desk"),
+    ("sort the cubes by color", "sort_blocks_by_colour"),
+    ("make a pile of blocks", "build_a_tower"),
+    ("switch everything off before leaving", "shut_down_for_the_night"),
+    ("serve some coffee", "serve_tea"),
+    ("lay the dinner table", "set_the_table"),
+    ("Tidy up the kitchen counter, please!", "tidy_the_kitchen"),
+])
+def test_paraphrases_reach_their_goal(text: str, goal: str) -> None:
+    plan = OFFLINE.plan(text)
+    assert plan.goal == goal and plan.instruction == text
+
+
+def test_explicit_sequences_become_subtasks() -> None:
+    plan = OFFLINE.plan("Put the mouse on the pad, then press the bell")
+    assert [st.skill for st in plan.subtasks] == ["pick_and_place", "press"]
+    assert {o.type for o in plan.objects} == {"mouse", "mouse_pad", "bell"}
+    assert [str(p) for p in plan.subtasks[0].predicates] == ["on(mouse, mouse_pad)", "released(mouse)"]
+    three = OFFLINE.plan("put the red block on the blue block, put the green block on the red block "
+                         "and then ring the bell")
+    assert [o.name for o in three.objects] == ["red_block", "blue_block", "green_block", "bell"]
+    assert three.subtasks[1].args == {"obj": "green_block", "target": "red_block"}
+    nested = OFFLINE.plan("put the small bowl in the other bowl")
+    assert nested.subtasks[0].args["obj"] != nested.subtasks[0].args["target"]
+    assert str(nested.subtasks[0].predicates[0]).startswith("inside(")
+
+
+@pytest.mark.parametrize("text, message", [
+    ("", "empty or unintelligible"),
+    ("?!", "empty or unintelligible"),
+    ("fly to the moon", "cannot ground 'fly to the moon'.*LLM planner"),
+    ("put the unicorn on the pad", "unknown object 'the unicorn'.*known objects: .*mouse pad"),
+    ("put the purple mouse on the pad", "no purple mouse"),
+    ("put the mouse on the apple", "nothing can be put on or in the apple"),
+    ("press the apple", "cannot be pressed.*pressable: "),
+])
+def test_offline_refusals_say_what_it_can_do(text: str, message: str) -> None:
+    with pytest.raises(PlanningError, match=message):
+        OFFLINE.plan(text)
+
+
+def test_plan_schema_rejects_bad_plans() -> None:
+    good = GOALS[0].plan("x").model_dump()
+    Plan.model_validate(good)
+    for path, value, message in [
+        (("objects", 0, "type"), "unicorn", "unknown object type 'unicorn'"),
+        (("subtasks", 0, "skill"), "teleport", "unknown skill 'teleport'"),
+        (("subtasks", 0, "args"), {"obj": "ghost"}, "unknown object"),
+        (("subtasks", 0, "args"), {"obj": "clock", "speed": 3}, "has no argument"),
+        (("subtasks", 0, "predicates"), [{"name": "on", "args": ["clock"]}], "takes 2..2 objects"),
+    ]:
+        bad = json.loads(json.dumps(good, default=list))
+        node = bad
+        for key in path[:-1]:
+            node = node[key]
+        node[path[-1]] = value
+        with pytest.raises(ValueError, match=message):
+            Plan.model_validate(bad)
+
+
+# -- LLM planner against a local OpenAI-protocol server ------------------------------------------
+
+@pytest.fixture()
+def server() -> Iterator[FakeOpenAI]:
+    with FakeOpenAI() as srv:
+        yield srv
+
+
+def _planner(server: FakeOpenAI, **kw: float) -> LLMPlanner:
+    cfg = BackendConfig(base_url=server.base_url, model="fake-planner", timeout=kw.get("timeout", 5.0),
+                        max_retries=int(kw.get("retries", 0)), backoff=0.01)
+    return LLMPlanner(make_backend("openai", cfg))
+
+
+VALID = {"objects": [{"name": "mouse", "type": "mouse"}, {"name": "pad", "type": "mouse_pad"}],
+         "subtasks": [{"skill": "pick_and_place", "args": {"obj": "mouse", "target": "pad"},
+                       "description": "the mouse lies on the pad",
+                       "predicates": [{"name": "on", "args": ["mouse", "pad"]}]}]}
+
+
+def test_llm_planner_valid_reply(server: FakeOpenAI) -> None:
+    server.script(json.dumps(VALID))
+    plan = _planner(server).plan("tidy the mouse away")
+    assert plan.instruction == "tidy the mouse away" and plan.subtasks[0].args["target"] == "pad"
+    request = server.requests[0]
+    assert request["model"] == "fake-planner" and request["response_format"] == {"type": "json_object"}
+    prompt = request["messages"][0]["content"]
+    assert "pick_and_place(obj" in prompt and "mouse_pad" in prompt and '"subtasks"' in prompt
+
+
+def test_llm_planner_repairs_malformed_json_and_schema_violations(server: FakeOpenAI) -> None:
+    bad_type = dict(VALID, objects=[{"name": "mouse", "type": "hamster"},
+                                    {"name": "pad", "type": "mouse_pad"}])
+    server.script("```json\n{not json", json.dumps(bad_type), "```json\n" + json.dumps(VALID) + "\n```")
+    plan = _planner(server).plan("put the mouse on its pad")
+    assert plan.objects[0].type == "mouse" and len(server.requests) == 3
+    repair1 = server.requests[1]["messages"][-1]["content"]
+    repair2 = server.requests[2]["messages"][-1]["content"]
+    assert "not valid JSON" in repair1 and "unknown object type 'hamster'" in repair2
+
+
+def test_llm_planner_gives_up_after_bounded_repairs(server: FakeOpenAI) -> None:
+    server.script("[]", "{}", '{"objects": []}')
+    with pytest.raises(PlanningError, match="no valid plan .* after 3 replies"):
+        _planner(server).plan("put the mouse on its pad")
+    assert len(server.requests) == 3
+
+
+def test_llm_planner_timeout_is_typed(server: FakeOpenAI) -> None:
+    server.script(Delay(2.0, then=json.dumps(VALID)))
+    with pytest.raises(BackendTimeout):
+        _planner(server, timeout=0.2).plan("put the mouse on its pad")
+
+
+def test_llm_planner_needs_a_model_name(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.delenv("VCAGE_LLM_MODEL", raising=False)
+    with pytest.raises(ConfigError, match="VCAGE_LLM_MODEL"):
+        make_planner("llm")
+    assert PLANNERS.names() == ["llm", "offline"]
