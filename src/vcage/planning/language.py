@@ -11,8 +11,11 @@ import math
 import re
 from collections.abc import Iterable
 
-STOP = frozenset(
-    ["a", "an", "the", "my", "our", "your", "his", "her", "their", "its", "this", "that", "these", "those", "to", "for", "of", "and", "or", "please", "can", "could", "would", "you", "will", "i", "we", "me", "us", "it", "be", "is", "are", "get", "go", "do", "some", "all", "just", "now", "then", "up", "down", "with", "at", "by", "let", "lets", "want", "need", "like"])
+_STOP_WORDS = """
+a an the my our your his her their its this that these those to for of and or please can could
+would you will i we me us it be is are get go do some all just now then up down with at by let
+lets want need like"""
+STOP = frozenset(_STOP_WORDS.split())
 
 # canonical word <- variants (after stemming)
 SYNONYMS: dict[str, tuple[str, ...]] = {

@@ -68,8 +68,6 @@ def task_layout(items: Sequence[Item], rng: np.random.Generator, rand: Randomiza
     scale, colour, friction, table, light and cameras are drawn from ``rng``."""
     objects = []
     for item in items:
-        otype = CATALOG.get(item.type)
-        variants = item.colors or tuple(otype.colors)
         if not rand.enabled or not item.jitter:
             region, yaw = Region(item.xy), (item.yaw, item.yaw)
         else:
@@ -77,22 +75,17 @@ def task_layout(items: Sequence[Item], rng: np.random.Generator, rand: Randomiza
             mid = (lo + hi) / 2
             region = Region((item.xy[0] + mid, item.xy[1] + mid), ((hi - lo) / 2, (hi - lo) / 2))
             yaw = (item.yaw + rand.object_yaw.low, item.yaw + rand.object_yaw.high)
-        if not rand.enabled:
-            objects.append(LayoutObject(item.name, item.type, region=region, yaw=yaw,
-                                        color=variants[0]))
-            continue
-        lo_s = max(otype.scale_range[0], rand.scale.low)
-        hi_s = min(otype.scale_range[1], rand.scale.high)
-        objects.append(LayoutObject(
-            item.name, item.type, region=region, yaw=yaw,
-            scale=float(rng.uniform(lo_s, hi_s)) if hi_s > lo_s else 1.0,
-            color=str(variants[rng.integers(len(variants))]) if rand.color else variants[0],
-            friction=_uniform(rng, rand.friction),
-        ))
-    common = {"objects": tuple(objects), "relations": tuple(relations), "reserved": tuple(reserved),
-              "distractors": Distractors(clutter)}
+        scale, color, friction = object_look(item.type, rng, rand, item.colors)
+        objects.append(LayoutObject(item.name, item.type, region=region, yaw=yaw, scale=scale,
+                                    color=color, friction=friction))
+    return LayoutSpec(objects=tuple(objects), relations=tuple(relations), reserved=tuple(reserved),
+                      distractors=Distractors(clutter), **environment(rng, rand))
+
+
+def environment(rng: np.random.Generator, rand: Randomization) -> dict[str, Any]:
+    """Table, light and camera jitter of a layout: nominal, or drawn from ``rng``."""
     if not rand.enabled:
-        return LayoutSpec(**common)  # type: ignore[arg-type]
+        return {}
     table = TableSpec(
         height=NOMINAL_TABLE_HEIGHT + _uniform(rng, rand.table_height),
         rgba=TABLE_COLORS[rng.integers(len(TABLE_COLORS))] if rand.color else TABLE_COLORS[0],
@@ -100,5 +93,18 @@ def task_layout(items: Sequence[Item], rng: np.random.Generator, rand: Randomiza
     )
     cam = (_uniform(rng, rand.camera_jitter), _uniform(rng, rand.camera_jitter),
            _uniform(rng, rand.camera_jitter))
-    return LayoutSpec(**common, table=table, light=_uniform(rng, rand.light),  # type: ignore[arg-type]
-                      camera_offset=cam)
+    return {"table": table, "light": _uniform(rng, rand.light), "camera_offset": cam}
+
+
+def object_look(otype_name: str, rng: np.random.Generator, rand: Randomization,
+                colors: tuple[str, ...] | None = None) -> tuple[float, str, float]:
+    """Scale, colour and friction of one object: nominal, or drawn from ``rng``."""
+    otype = CATALOG.get(otype_name)
+    variants = colors or tuple(otype.colors)
+    if not rand.enabled:
+        return 1.0, variants[0], 1.0
+    lo_s = max(otype.scale_range[0], rand.scale.low)
+    hi_s = min(otype.scale_range[1], rand.scale.high)
+    scale = float(rng.uniform(lo_s, hi_s)) if hi_s > lo_s else 1.0
+    color = str(variants[rng.integers(len(variants))]) if rand.color else variants[0]
+    return scale, color, _uniform(rng, rand.friction)
