@@ -20,11 +20,11 @@ from pathlib import Path
 
 import numpy as np
 
-from vcage.errors import PlacementError
+from vcage.errors import PlacementError, SimulationError
 from vcage.scene.compose import compose
 from vcage.scene.layout import Distractors, LayoutSpec
 from vcage.scene.placement import PLACERS, place
-from vcage.scene.stability import check_stability
+from vcage.scene.stability import StabilityReport, check_stability
 from vcage.skills.reach import reach_map
 
 METHODS = ("context", "rejection", "naive")
@@ -47,8 +47,10 @@ def _one(job: tuple[str, int, int, bool]) -> dict:
            if not r_in <= float(np.hypot(*o.xy)) <= r_out]  # the robot's base axis is at x = y = 0
     row.update(placed=True, seconds=result.stats.seconds, coverage=result.stats.coverage,
                unreachable=bool(far))
-    world = compose(result.scene).make_world()
-    report = check_stability(world)
+    try:
+        report = check_stability(compose(result.scene).make_world())
+    except SimulationError as exc:  # the physics could not even start from this state
+        report = StabilityReport(error=str(exc))
     row.update(interpenetrating=report.interpenetrating, unstable=not report.stable,
                reason="" if report.ok else report.reason())
     return row

@@ -29,6 +29,8 @@ CAMERAS = {
 TOP_CAMERA = "top"
 TOP_CAMERA_HEIGHT = 1.5  # above the table top
 OFFSCREEN_SIZE = (640, 480)
+ARENA_BASE = 32 * 2**20  # bytes of MuJoCo arena (contacts, constraints) per scene ...
+ARENA_PER_OBJECT = 4 * 2**20  # ... plus this per object
 
 
 @dataclass(frozen=True)
@@ -147,6 +149,8 @@ def compose(scene: SceneSpec, sim: SimConfig = SimConfig()) -> ComposedScene:
         _add_object(spec, otype, obj.name, [obj.xy[0], obj.xy[1], z], obj.yaw, obj.scale,
                     otype.color(obj.color), obj.friction)
     spec.add_key(name="home")
+    # Room for the contacts of a cluttered (or badly placed) scene; pages are only touched as used.
+    spec.memory = ARENA_BASE + ARENA_PER_OBJECT * len(scene.objects)
     model = spec.compile()
     _set_home_key(model)
     objects = {

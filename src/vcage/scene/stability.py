@@ -10,7 +10,6 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-import mujoco
 import numpy as np
 
 from vcage.errors import SimulationError
@@ -79,7 +78,10 @@ def penetrations(world: World, depth: float) -> list[tuple[str, str, float]]:
 def check_stability(world: World, config: StabilityConfig | None = None) -> StabilityReport:
     """Check the world as composed (call before stepping it), then settle it and check again."""
     cfg = config or StabilityConfig()
-    mujoco.mj_forward(world.model, world.data)
+    try:
+        world.forward()
+    except SimulationError as exc:
+        return StabilityReport(error=str(exc))
     pens = tuple(penetrations(world, cfg.penetration))
     start = {n: (world.object_pos(n), world.object_mat(n)) for n in world.objects}
     try:

@@ -59,14 +59,24 @@ class World:
             mujoco.mj_resetDataKeyframe(self.model, self.data, key)
         else:
             mujoco.mj_resetData(self.model, self.data)
-        mujoco.mj_forward(self.model, self.data)
+        self.forward()
+
+    def forward(self) -> None:
+        """Recompute derived quantities (contacts, positions) without advancing time."""
+        try:
+            mujoco.mj_forward(self.model, self.data)
+        except mujoco.FatalError as exc:
+            raise SimulationError(_fatal_message(exc)) from exc
 
     def step(self, ctrl: np.ndarray | None = None) -> None:
         """Apply ``ctrl`` (if given) and advance one control period; raise if unstable."""
         if ctrl is not None:
             self.data.ctrl[:] = ctrl
         before = self._bad_state_warnings()
-        mujoco.mj_step(self.model, self.data, nstep=self.substeps)
+        try:
+            mujoco.mj_step(self.model, self.data, nstep=self.substeps)
+        except mujoco.FatalError as exc:
+            raise SimulationError(_fatal_message(exc)) from exc
         if self._bad_state_warnings() > before:  # MuJoCo reset the data after NaN/Inf/huge values
             raise SimulationError(
                 f"simulation unstable near t={self.data.time:.3f}s: MuJoCo found NaN, Inf or huge "
@@ -105,7 +115,7 @@ class World:
 
     def set_state(self, state: np.ndarray) -> None:
         mujoco.mj_setState(self.model, self.data, np.asarray(state, dtype=float), STATE_SPEC)
-        mujoco.mj_forward(self.model, self.data)
+        self.forward()
 
     # -- object queries ----------------------------------------------------------------------
     def object(self, name: str) -> ObjectInstance:
@@ -143,3 +153,9 @@ class World:
 
     def joint_value(self, name: str) -> float:
         return float(self.data.joint(name).qpos[0])
+
+
+def _fatal_message(exc: Exception) -> str:
+    first = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
+    return (f"MuJoCo gave up on this state ({first}); usually objects interpenetrate deeply and "
+            "generate more contacts than the solver's memory holds: check the scene's placement")
