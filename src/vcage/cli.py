@@ -46,6 +46,128 @@ def list_tasks() -> None:
         task.build(np.random.default_rng(0), Randomization.off())
         table.add_row(name, task.instruction())
     console.print(table)
+    from vcage.planning.goals import GOALS
+
+    goals = Table("long-horizon goal", "subtasks", "example instructions")
+    for g in GOALS:
+        goals.add_row(g.name, str(len(g.subtasks)), "; ".join(g.phrasings[:2]))
+    console.print(goals)
+    console.print("explicit sequences also work, e.g. 'put the mouse on the mouse pad, then press the bell'")
+
+
+@app.command("plan")
+def plan_cmd(instruction: str = typer.Argument(..., help="what the robot should do"),
+             planner: str = typer.Option("offline", help="offline, or llm (VCAGE_LLM_* env vars)")) -> None:
+    """Ground INSTRUCTION into a plan and print it (nothing is simulated)."""
+    from vcage.planning import make_planner
+
+    try:
+        result = make_planner(planner).plan(instruction)
+    except VcageError as exc:
+        _fail(exc)
+        return
+    console.print(result.summary(), markup=False, highlight=False)
+
+
+@app.command("generate")
+def generate_cmd(
+        instruction: str = typer.Argument(..., help="e.g. 'get ready for work'"),
+        episodes: int = typer.Option(3, min=1, help="accepted episodes to produce"),
+        out: Path = typer.Option(Path("out/dataset"), help="dataset directory (LeRobot v3 layout)"),
+        mode: str = typer.Option("vcage", help="vcage, or vanilla (naive placement, no critic)"),
+        planner: str = typer.Option("offline", help="offline or llm"),
+        critic: str = typer.Option("oracle", help="critic that verifies each subtask"),
+        placement: str = typer.Option("context", help="context, naive or rejection"),
+        clutter: int = typer.Option(4, min=0, help="distractors per scene"),
+        seed: int = typer.Option(0), max_attempts: int = typer.Option(10, min=1),
+        cameras: str = typer.Option("front,panda/wrist", help="comma-separated cameras to record"),
+        size: int = typer.Option(128, help="video width and height (even)")) -> None:
+    """Generate a verified dataset for INSTRUCTION; prints the funnel and writes stats.json."""
+    from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
+
+    from vcage.pipeline.config import GenerateConfig
+    from vcage.pipeline.generate import generate
+
+    try:
+        cfg = GenerateConfig(mode=mode, planner=planner, critic=critic, placement=placement,
+                             clutter=clutter, seed=seed, max_attempts=max_attempts,
+                             cameras=tuple(c.strip() for c in cameras.split(",") if c.strip()),
+                             size=(size, size))
+        with Progress(TextColumn("{task.description}"), BarColumn(),
+                      TextColumn("{task.completed}/{task.total}"), TimeElapsedColumn(),
+                      console=console) as bar:
+            job = bar.add_task("episodes", total=episodes)
+
+            def update(f: object) -> None:
+                from vcage.pipeline.generate import Funnel
+
+                assert isinstance(f, Funnel)
+                bar.update(job, completed=f.accepted + f.given_up,
+                           description=f"episodes (attempts {f.attempts}, accepted {f.accepted})")
+
+            funnel = generate(instruction, episodes, out, cfg, progress=update)
+    except VcageError as exc:
+        _fail(exc)
+        return
+    _print_funnel(funnel.to_dict(), out)
+
+
+def _print_funnel(stats: dict, out: Path) -> None:
+    table = Table("stage", "attempts")
+    for stage, n in sorted(stats["stages"].items(), key=lambda kv: -kv[1]):
+        table.add_row(stage, str(n))
+    console.print(table)
+    if stats["rejections_by_reason"]:
+        reasons = Table("rejected at: reason", "attempts")
+        for reason, n in stats["rejections_by_reason"].items():
+            reasons.add_row(reason, str(n))
+        console.print(reasons)
+    ratio = stats["total_over_physics_and_render"]
+    console.print(
+        f"accepted {stats['accepted']}/{stats['episodes_requested']} episodes in {stats['attempts']} "
+        f"attempts ({stats['given_up']} given up); label noise (oracle audit of accepted): "
+        f"{stats['label_noise']:.1%}; {stats['wall_seconds']:.1f} s wall, "
+        f"{stats['episodes_per_hour']:.0f} episodes/hour; total / (physics + render) = "
+        f"{ratio:.2f}" if ratio else "")
+    console.print(f"dataset and stats.json in {out}/")
+
+
+@app.command("inspect")
+def inspect_cmd(path: Path = typer.Argument(..., help="a dataset directory")) -> None:
+    """Summarise a dataset: episodes, frames, tasks, cameras and per-episode outcomes."""
+    from vcage.data import DatasetReader
+
+    try:
+        reader = DatasetReader(path)
+        rows = [(i, reader.episode_meta(i), reader.extras(i)) for i in range(reader.num_episodes)]
+    except VcageError as exc:
+        _fail(exc)
+        return
+    console.print(f"{path}: {reader.num_episodes} episodes, {reader.total_frames} frames at "
+                  f"{reader.fps} fps; "
+                  f"cameras {', '.join(f'{k} {w}x{h}' for k, (h, w) in reader.cameras.items())}")
+    table = Table("episode", "frames", "seed", "subtasks", "oracle", "task")
+    for i, meta, extras in rows:
+        table.add_row(str(i), str(meta.get("length")), str(extras.get("seed")),
+                      str(len(extras.get("subtasks", []))),
+                      "ok" if extras.get("oracle_success") else "[red]failed[/red]",
+                      str(meta.get("tasks", [""])[0]))
+    console.print(table)
+
+
+@app.command("audit")
+def audit_cmd(path: Path = typer.Argument(..., help="a dataset directory")) -> None:
+    """Label noise of a dataset and the critic's agreement with the oracle, from the attempt log."""
+    from vcage.data import DatasetReader
+    from vcage.pipeline.audit import audit
+
+    try:
+        DatasetReader(path)
+        report = audit(path)
+    except VcageError as exc:
+        _fail(exc)
+        return
+    console.print(report.summary())
 
 
 @app.command("catalog")

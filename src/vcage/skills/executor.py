@@ -28,6 +28,7 @@ class Recording:
     ee_quat: list[np.ndarray] = field(default_factory=list)
     action: list[np.ndarray] = field(default_factory=list)  # (8,) arm targets + gripper command
     time: list[float] = field(default_factory=list)
+    states: list[np.ndarray] = field(default_factory=list)  # full simulator states, if recorded
     skills: list[tuple[str, int, int]] = field(default_factory=list)  # (skill, first, end) steps
 
     def __len__(self) -> int:
@@ -44,9 +45,10 @@ class Recording:
 class Executor:
     """Interpolates waypoints with minimum-jerk timing and steps the world once per control tick."""
 
-    def __init__(self, world: World, record: bool = True) -> None:
+    def __init__(self, world: World, record: bool = True, record_states: bool = False) -> None:
         self.world = world
         self.record = record
+        self.record_states = record_states  # also keep every step's full state (for replay/video)
         self.recording = Recording()
         self.hooks: list[StepHook] = []
         robot = world.robot
@@ -84,6 +86,8 @@ class Executor:
             rec.ee_quat.append(mat_to_quat(mat))
             rec.action.append(np.append(self.q_cmd, self.gripper_cmd))
             rec.time.append(float(data.time))
+            if self.record_states:
+                rec.states.append(world.get_state())
         world.step(robot.ctrl(self.q_cmd, self.gripper_cmd))
         for hook in self.hooks:
             hook(world)

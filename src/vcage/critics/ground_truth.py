@@ -1,0 +1,22 @@
+"""The oracle as a critic: accepts exactly when the subtask's ground-truth predicates hold.
+
+Useful as an upper bound and for debugging; the default critics judge from images only.
+"""
+
+from __future__ import annotations
+
+from vcage.critics.base import CRITICS, Critic, Observation, Verdict
+
+
+class OracleCritic(Critic):
+    name = "oracle"
+    needs_views = False
+
+    def judge(self, obs: Observation) -> Verdict:
+        failed = [k for k, v in obs.oracle.items() if not v]
+        if failed:
+            return Verdict(False, "predicates do not hold: " + ", ".join(failed))
+        return Verdict(True, "all predicates hold: " + ", ".join(obs.oracle))
+
+
+CRITICS.add("oracle", lambda **_: OracleCritic())

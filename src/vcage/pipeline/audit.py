@@ -1,0 +1,86 @@
+"""Label noise and critic-oracle agreement, from a dataset's attempt log.
+
+Every attempt (accepted or rejected) is logged with the critic's verdict and the oracle's audit
+of each subtask it ran. Label noise is the share of accepted episodes that the oracle says failed;
+agreement compares the critic's per-subtask verdicts with the oracle's (accept = positive).
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import asdict, dataclass
+from pathlib import Path
+from typing import Any
+
+from vcage.errors import DatasetError
+from vcage.pipeline.generate import ATTEMPTS_LOG
+
+
+@dataclass(frozen=True)
+class AuditReport:
+    attempts: int
+    accepted: int
+    accepted_oracle_failed: int
+    judged_subtasks: int
+    true_accept: int
+    false_accept: int  # critic accepted, oracle says failed
+    false_reject: int  # critic rejected, oracle says succeeded
+    true_reject: int
+
+    @property
+    def label_noise(self) -> float:
+        return self.accepted_oracle_failed / self.accepted if self.accepted else 0.0
+
+    @property
+    def agreement(self) -> float:
+        n = self.judged_subtasks
+        return (self.true_accept + self.true_reject) / n if n else 0.0
+
+    @property
+    def precision(self) -> float:
+        n = self.true_accept + self.false_accept
+        return self.true_accept / n if n else 0.0
+
+    @property
+    def recall(self) -> float:
+        n = self.true_accept + self.false_reject
+        return self.true_accept / n if n else 0.0
+
+    def to_dict(self) -> dict[str, Any]:
+        return {**asdict(self), "label_noise": self.label_noise, "agreement": self.agreement,
+                "precision": self.precision, "recall": self.recall}
+
+    def summary(self) -> str:
+        return (f"{self.accepted} accepted episodes of {self.attempts} attempts; label noise "
+                f"{self.label_noise:.1%} ({self.accepted_oracle_failed} accepted episodes fail the oracle)\n"
+                f"critic vs oracle on {self.judged_subtasks} judged subtasks: agreement "
+                f"{self.agreement:.1%}, "
+                f"precision {self.precision:.1%}, recall {self.recall:.1%} "
+                f"(false accepts {self.false_accept}, false rejects {self.false_reject})")
+
+
+def audit(root: Path) -> AuditReport:
+    path = Path(root) / ATTEMPTS_LOG
+    if not path.is_file():
+        raise DatasetError(f"{path} is missing: the dataset was not made by `vcage generate`, or its "
+                           "attempt log was removed")
+    counts = dict.fromkeys(("attempts", "accepted", "accepted_oracle_failed", "judged_subtasks",
+                            "true_accept", "false_accept", "false_reject", "true_reject"), 0)
+    for n, line in enumerate(path.read_text().splitlines(), 1):
+        try:
+            rec = json.loads(line)
+        except json.JSONDecodeError:
+            raise DatasetError(f"{path} line {n} is not JSON; the log is corrupt") from None
+        counts["attempts"] += 1
+        if rec["stage"] == "accepted":
+            counts["accepted"] += 1
+            counts["accepted_oracle_failed"] += not rec["oracle_success"]
+        for audit_row, verdict in zip(rec["audit"], rec["verdicts"], strict=False):
+            if not verdict:
+                continue
+            counts["judged_subtasks"] += 1
+            critic, oracle = bool(verdict.get("accept")), bool(audit_row["oracle_success"])
+            key = {(True, True): "true_accept", (True, False): "false_accept",
+                   (False, True): "false_reject", (False, False): "true_reject"}[(critic, oracle)]
+            counts[key] += 1
+    return AuditReport(**counts)

@@ -1,0 +1,95 @@
+"""Execute a plan's subtasks in order on a world, auditing each one with the oracle.
+
+After every subtask the command is held for a moment (success must hold on consecutive control
+steps), the oracle's verdict is recorded with the subtask's frame boundaries, and an optional
+``judge`` (the critic) decides whether to go on. A skill that cannot plan ends the rollout.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+from vcage.critics.oracle import Oracle
+from vcage.errors import SkillError
+from vcage.planning.schema import Plan, Subtask
+from vcage.sim.world import World
+from vcage.skills.primitives import Skills
+
+HOLD_STEPS = 5  # the oracle's predicates must hold this many consecutive control steps
+
+
+@dataclass
+class SubtaskOutcome:
+    index: int
+    skill: str
+    description: str
+    start: int  # first frame of the subtask in the recording
+    end: int  # one past its last frame
+    oracle: dict[str, bool]
+    oracle_success: bool
+    skill_error: str | None = None
+    verdict: dict[str, Any] | None = None  # the critic's, when one judged
+
+
+@dataclass
+class Rollout:
+    outcomes: list[SubtaskOutcome] = field(default_factory=list)
+    aborted_at: int | None = None  # index of the subtask after which the judge stopped it
+
+    @property
+    def oracle_success(self) -> bool:
+        return bool(self.outcomes) and all(o.oracle_success for o in self.outcomes)
+
+
+Judge = Callable[[SubtaskOutcome], dict[str, Any]]  # returns a verdict with a boolean "accept"
+
+
+def run_plan(world: World, plan: Plan, skills: Skills | None = None, judge: Judge | None = None,
+             on_subtask_start: Callable[[int, Subtask], None] | None = None) -> tuple[Rollout, Skills]:
+    skills = skills or Skills(world)
+    oracle = Oracle()
+    skills.executor.hooks.append(oracle.on_step)
+    rollout = Rollout()
+    for i, sub in enumerate(plan.subtasks):
+        if on_subtask_start is not None:
+            on_subtask_start(i, sub)
+        oracle.begin(sub)
+        start = len(skills.executor.recording)
+        error = None
+        try:
+            skills.do(sub.skill, **_skill_args(sub))
+            skills.do("retreat", home=False)
+        except SkillError as exc:
+            error = str(exc)
+        values = _held(world, skills, oracle, sub)
+        outcome = SubtaskOutcome(i, sub.skill, sub.description, start, len(skills.executor.recording),
+                                 values, error is None and all(values.values()), error)
+        rollout.outcomes.append(outcome)
+        if error is not None:
+            rollout.aborted_at = i
+            break
+        if judge is not None:
+            outcome.verdict = judge(outcome)
+            if not outcome.verdict.get("accept", False):
+                rollout.aborted_at = i
+                break
+    return rollout, skills
+
+
+def _skill_args(sub: Subtask) -> dict[str, Any]:
+    args = dict(sub.args)
+    if isinstance(args.get("xy"), list):
+        args["xy"] = tuple(args["xy"])
+    return args
+
+
+def _held(world: World, skills: Skills, oracle: Oracle, sub: Subtask) -> dict[str, bool]:
+    streak: dict[str, int] = {}
+    values: dict[str, bool] = {}
+    for _ in range(HOLD_STEPS * 2):
+        skills.executor.wait(world.control_dt)
+        values = oracle.check(world, sub)
+        streak = {k: (streak.get(k, 0) + 1 if v else 0) for k, v in values.items()}
+    return {k: streak[k] >= HOLD_STEPS for k in values}
