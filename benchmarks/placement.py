@@ -132,7 +132,8 @@ def main() -> None:
                   f"{np.percentile(secs, 95) * 1e3:10.3f} {cov:8.1%}")
             for r in cell:
                 if r["reason"]:
-                    key = re.sub(r"\d+", "N", r["reason"].split("(")[0].split(";")[0].strip())[:50]
+                    first = re.sub(r"'[^']*'", "X", r["reason"].split(";")[0].split("(")[0])
+                    key = re.sub(r"\d+", "N", first).strip()[:60]
                     reasons.setdefault((method, count), {}).setdefault(key, 0)
                     reasons[(method, count)][key] += 1
     print("\nplaced: every object placed; success: placed, no interpenetration and stable; "

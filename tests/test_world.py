@@ -61,8 +61,8 @@ def test_render_rgb_depth_and_segmentation(world: World) -> None:
         with pytest.raises(ConfigError, match="perspective"):
             r.depth("top")
         seg = r.segmentation("top")
-        # both blocks are visible from the top and mapped to their object index
-        assert set(np.unique(seg)) == {-1, 0, 1}
+        # both blocks are visible from the top and mapped to their object index; the robot is -2
+        assert set(np.unique(seg)) == {-2, -1, 0, 1}
         # block "b" is at +y, i.e. on the image's left half in the top view (+x is up)
         cols = np.nonzero(seg == world.object_names.index("b"))[1]
         assert cols.mean() < 64

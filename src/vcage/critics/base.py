@@ -22,6 +22,7 @@ from vcage.registry import Registry
 class View:
     rgb: np.ndarray  # (H, W, 3) uint8
     segmentation: np.ndarray  # (H, W) int32: object index into Observation.labels, -1 other, -2 robot
+    depth: np.ndarray | None = None  # (H, W) metres along the view axis (perspective cameras)
 
 
 @dataclass(frozen=True)
@@ -30,6 +31,7 @@ class Observation:
     labels: tuple[str, ...]  # object names by segmentation index
     before: dict[str, View] = field(default_factory=dict)  # camera -> view before the subtask
     after: dict[str, View] = field(default_factory=dict)  # camera -> view after it
+    during: dict[str, View] = field(default_factory=dict)  # at the subtask's deepest moment (a press)
     oracle: dict[str, bool] = field(default_factory=dict)  # ground truth (the oracle critic only)
 
 

@@ -18,14 +18,14 @@ class GenerateConfig:
 
     mode: str = "vcage"
     planner: str = "offline"
-    critic: str = "oracle"
+    critic: str = "image"
     placement: str = "context"
     clutter: int = 4
     seed: int = 0
     max_attempts: int = 10  # scene re-samples per episode before the episode is given up
     cameras: tuple[str, ...] = ("front", "panda/wrist")  # recorded as videos
     size: tuple[int, int] = (128, 128)  # width, height of the videos
-    critic_size: tuple[int, int] = (160, 120)  # width, height of the critic's views
+    critic_size: tuple[int, int] = (320, 240)  # width, height of the critic's views
     randomization: Randomization = field(default_factory=Randomization)
 
     def __post_init__(self) -> None:

@@ -115,6 +115,8 @@ def _attempt(plan: Plan, seed: int, cfg: GenerateConfig, critic: Critic | None, 
         renderer = Renderer(world, *cfg.critic_size) if critic is not None and critic.needs_views else None
         try:
             judge = Judge(world, plan, critic, renderer, timing) if critic is not None else None
+            if judge is not None:
+                judge.skills_recording = skills.executor.recording
             rollout, skills = run_plan(world, plan, skills, judge,
                                        on_subtask_start=judge.start if judge else None)
         finally:
@@ -141,12 +143,14 @@ class Judge:
         self.world, self.plan, self.critic = world, plan, critic
         self.renderer, self.timing = renderer, timing
         self._before: dict[str, View] = {}
+        self.skills_recording: Recording | None = None
 
     def _views(self) -> dict[str, View]:
         if self.renderer is None:
             return {}
         t0 = time.perf_counter()
-        views = {cam: View(self.renderer.rgb(cam), self.renderer.segmentation(cam))
+        views = {cam: View(self.renderer.rgb(cam), self.renderer.segmentation(cam),
+                           self.renderer.depth(cam) if cam in DEPTH_CAMERAS else None)
                  for cam in CRITIC_CAMERAS}
         self.timing.render += time.perf_counter() - t0
         return views
@@ -156,8 +160,27 @@ class Judge:
 
     def __call__(self, outcome: SubtaskOutcome) -> dict[str, Any]:
         obs = Observation(subtask=self.plan.subtasks[outcome.index], labels=tuple(self.world.object_names),
-                          before=self._before, after=self._views(), oracle=outcome.oracle)
+                          before=self._before, after=self._views(), during=self._deepest(outcome),
+                          oracle=outcome.oracle)
         return self.critic.judge(obs).to_dict()
+
+    def _deepest(self, outcome: SubtaskOutcome) -> dict[str, View]:
+        """Views of the recorded frame where the hand was lowest during the subtask (e.g. a press).
+
+        The frame is chosen from proprioception (the hand's height), as on a real robot.
+        """
+        rec = self.skills_recording
+        if self.renderer is None or rec is None or outcome.end <= outcome.start or not rec.states:
+            return {}
+        heights = [p[2] for p in rec.ee_pos[outcome.start:outcome.end]]
+        frame = outcome.start + int(np.argmin(heights))
+        now = self.world.get_state()
+        self.world.set_state(rec.states[frame])
+        try:
+            return self._views()
+        finally:
+            self.world.set_state(now)
 
 
 CRITIC_CAMERAS = ("top", "front")  # the views a critic gets: top-down (orthographic) and front
+DEPTH_CAMERAS = ("front",)  # ... with depth where the camera is perspective (RGB-D)

@@ -60,7 +60,7 @@ def run_plan(world: World, plan: Plan, skills: Skills | None = None, judge: Judg
         error = None
         try:
             skills.do(sub.skill, **_skill_args(sub))
-            skills.do("retreat", home=False)
+            skills.do("retreat")  # back home: the views after the subtask show it unobstructed
         except SkillError as exc:
             error = str(exc)
         values = _held(world, skills, oracle, sub)

@@ -9,8 +9,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from vcage.assets.catalog import CATALOG
 from vcage.config import Randomization
-from vcage.planning.schema import Plan
+from vcage.planning.schema import Plan, PlanObject
 from vcage.scene.layout import (
     Distractors,
     LayoutObject,
@@ -22,14 +23,16 @@ from vcage.scene.layout import (
 )
 from vcage.tasks.layout import environment, object_look
 
-WORK_AREA = Region((0.55, 0.0), (0.13, 0.25))  # x 0.42..0.68, y -0.25..0.25 (metres)
+# x 0.45..0.70, y -0.3..0.3 (metres): reachable for every skill, and clear of the arm's home pose
+# in the top view, so that the critic sees the objects after each subtask
+WORK_AREA = Region((0.575, 0.0), (0.125, 0.3))
 TARGET_ZONE = 0.05  # half size of the zone kept free around a position target
 
 
 def plan_layout(plan: Plan, rng: np.random.Generator, rand: Randomization, clutter: int = 0,
                 work_area: Region = WORK_AREA) -> LayoutSpec:
     objects = []
-    for o in plan.objects:
+    for o in _largest_first(plan):
         scale, color, friction = object_look(o.type, rng, rand, (o.color,) if o.color else None)
         if o.scale is not None:
             scale = o.scale
@@ -44,3 +47,12 @@ def plan_layout(plan: Plan, rng: np.random.Generator, rand: Randomization, clutt
         for i, st in enumerate(plan.subtasks) if st.args.get("xy") is not None)
     return LayoutSpec(objects=tuple(objects), relations=relations, reserved=reserved,
                       distractors=Distractors(clutter), **environment(rng, rand))
+
+
+def _largest_first(plan: Plan) -> list[PlanObject]:
+    """Big footprints are the hardest to fit, so they are placed first (supports stay first)."""
+    def area(o: PlanObject) -> float:
+        sx, sy = CATALOG.get(o.type).size[:2]
+        return sx * sy
+
+    return sorted(plan.objects, key=lambda o: (o.on is not None, -area(o)))

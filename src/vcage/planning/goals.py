@@ -57,7 +57,7 @@ def put_at(obj: str, xy: tuple[float, float], text: str, left_of: str | None = N
                    predicates=tuple(preds))
 
 
-ROW_X = 0.42  # where arranged objects are lined up (as in blocks_ranking_rgb)
+ROW_X = 0.5  # where arranged objects are lined up (clear of the arm's home pose in the top view)
 
 GOALS: tuple[Goal, ...] = (
     Goal("get_ready_for_work",

@@ -1,7 +1,8 @@
 """Offscreen rendering of RGB, depth and object segmentation from any camera.
 
-Segmentation maps every pixel to the index of a catalog object instance (``world.object_names``)
-or -1 for the table, robot and background. Renderers hold GL contexts: close them explicitly or use
+Segmentation maps every pixel to the index of a catalog object instance (``world.object_names``),
+:data:`ROBOT` (-2) for the robot, or -1 for the table and background. Renderers hold GL contexts:
+close them explicitly or use
 them as context managers.
 """
 
@@ -15,6 +16,9 @@ import numpy as np
 
 from vcage.errors import ConfigError
 from vcage.sim.world import World
+
+ROBOT = -2  # segmentation label of the robot's pixels
+NONE = -1  # table, floor, background
 
 
 @dataclass(frozen=True)
@@ -67,7 +71,7 @@ class Renderer:
         return depth.astype(np.float32)
 
     def segmentation(self, camera: str) -> np.ndarray:
-        """Per-pixel object index into ``world.object_names`` (-1: not a catalog object)."""
+        """Per-pixel object index into ``world.object_names``; :data:`ROBOT` for the robot, else -1."""
         r = self._check(camera)
         r.enable_segmentation_rendering()
         try:
@@ -79,6 +83,9 @@ class Renderer:
         out = np.full(ids.shape, -1, dtype=np.int32)
         is_geom = (types == int(mujoco.mjtObj.mjOBJ_GEOM)) & (ids >= 0)
         out[is_geom] = self.world.object_of_geom(ids[is_geom])
+        robot = np.zeros_like(is_geom)
+        robot[is_geom] = self.world.geom_is_robot(ids[is_geom])
+        out[robot] = ROBOT
         return out
 
     def frame(self, camera: str, depth: bool = False, segmentation: bool = False) -> CameraFrame:

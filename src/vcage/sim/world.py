@@ -13,6 +13,7 @@ import numpy as np
 
 from vcage.config import SimConfig
 from vcage.errors import SimulationError
+from vcage.sim.robot import PREFIX as ROBOT_PREFIX
 from vcage.sim.robot import Robot
 
 STATE_SPEC = mujoco.mjtState.mjSTATE_INTEGRATION
@@ -46,6 +47,8 @@ class World:
         self.object_names = list(objects)
         for idx, inst in enumerate(objects.values()):
             self._root_to_object[inst.body_id] = idx
+        self.robot_bodies = np.array([model.body(i).name.startswith(ROBOT_PREFIX)
+                                      for i in range(model.nbody)])
         self.reset()
 
     @property
@@ -136,6 +139,9 @@ class World:
         """Index into :attr:`object_names` of each geom's object, or -1 for non-objects."""
         roots = self.model.body_rootid[self.model.geom_bodyid[geom_ids]]
         return self._root_to_object[roots]
+
+    def geom_is_robot(self, geom_ids: np.ndarray) -> np.ndarray:
+        return self.robot_bodies[self.model.geom_bodyid[geom_ids]]
 
     def body_owner(self, body_id: int) -> str:
         """The object a body belongs to, else the name of its root body (``table``, the robot's

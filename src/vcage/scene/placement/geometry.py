@@ -50,8 +50,13 @@ def erode_box(bounds: tuple[float, float, float, float], shape: Polygon) -> Poly
 
 
 def annulus(center: tuple[float, float], r_in: float, r_out: float, resolution: int = 32) -> BaseGeometry:
+    """The points between radii ``r_in`` and ``r_out``, approximated conservatively: the outer
+    circle by an inscribed polygon, the hole by a circumscribed one."""
     ring = Point(center).buffer(r_out, resolution)
-    return ring.difference(Point(center).buffer(r_in, resolution)) if r_in > 0 else ring
+    if r_in <= 0:
+        return ring
+    grow = 1.0 / math.cos(math.pi / (4 * resolution))  # buffer() uses 4 * resolution segments
+    return ring.difference(Point(center).buffer(r_in * grow, resolution))
 
 
 def sample_point(region: BaseGeometry, rng: np.random.Generator) -> tuple[float, float] | None:

@@ -1,0 +1,73 @@
+"""The image critic on real renders: it sees pixels and masks only, and says why it rejects."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from vcage.critics.base import Observation, View
+from vcage.critics.image import ImageCritic
+from vcage.critics.oracle import Oracle
+from vcage.planning.goals import put_at, put_on
+from vcage.scene.compose import compose
+from vcage.scene.spec import ObjectSpec, SceneSpec
+from vcage.sim.render import Renderer
+from vcage.sim.world import World
+
+CRITIC = ImageCritic()
+PAD = ObjectSpec("pad", "mouse_pad", (0.58, 0.1))
+
+
+def _views(world: World) -> dict[str, View]:
+    with Renderer(world, 320, 240) as r:
+        return {cam: View(r.rgb(cam), r.segmentation(cam), r.depth(cam) if cam == "front" else None)
+                for cam in ("top", "front")}
+
+
+def _world(*objects: ObjectSpec) -> World:
+    world = compose(SceneSpec(objects=objects)).make_world()
+    world.settle(0.3)
+    return world
+
+
+def _judge(before: World, after: World, subtask):  # type: ignore[no-untyped-def]
+    obs = Observation(subtask=subtask, labels=tuple(after.object_names), before=_views(before),
+                      after=_views(after))
+    return CRITIC.judge(obs), Oracle().check(after, subtask)
+
+
+def test_object_on_its_target_is_accepted_like_the_oracle() -> None:
+    start = _world(ObjectSpec("block", "block", (0.5, -0.15)), PAD)
+    done = _world(ObjectSpec("block", "block", (0.58, 0.1), z=0.756), PAD)
+    verdict, oracle = _judge(start, done, put_on("block", "pad", "the block is on the pad"))
+    assert verdict.accept, verdict.reason
+    assert all(oracle.values())
+
+
+def test_object_beside_its_target_is_rejected_with_the_reason() -> None:
+    start = _world(ObjectSpec("block", "block", (0.5, -0.15)), PAD)
+    missed = _world(ObjectSpec("block", "block", (0.58, -0.05)), PAD)
+    verdict, oracle = _judge(start, missed, put_on("block", "pad", "the block is on the pad"))
+    assert not verdict.accept and "overlaps pad from the top" in verdict.reason
+    assert not oracle["on(block, pad)"]
+
+
+def test_left_right_order_from_the_top_view() -> None:
+    world = _world(ObjectSpec("a", "block", (0.55, 0.15)), ObjectSpec("b", "block", (0.55, -0.15)))
+    sub = put_at("a", (0.55, 0.15), "a is left of b", left_of="b")
+    verdict, oracle = _judge(world, world, sub)
+    assert verdict.accept and oracle["left_of(a, b)"]
+    swapped = put_at("b", (0.55, -0.15), "b is left of a", left_of="a")
+    verdict, _ = _judge(world, world, swapped)
+    assert not verdict.accept and "column difference" in verdict.reason
+
+
+@pytest.mark.parametrize("missing", ["top", "front"])
+def test_missing_views_reject_instead_of_guessing(missing: str) -> None:
+    world = _world(ObjectSpec("block", "block", (0.58, 0.1), z=0.756), PAD)
+    views = _views(world)
+    del views[missing]
+    obs = Observation(subtask=put_on("block", "pad", "block on pad"), labels=tuple(world.object_names),
+                      before=views, after=views)
+    assert not CRITIC.judge(obs).accept
+    assert np.all(views[next(iter(views))].segmentation >= -2)
