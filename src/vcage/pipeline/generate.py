@@ -18,7 +18,7 @@ from typing import Any
 
 import numpy as np
 
-from vcage.critics import ground_truth, image  # noqa: F401  (register the critics)
+from vcage.critics import ground_truth, image, vlm  # noqa: F401  (register the critics)
 from vcage.critics.base import CRITICS, Critic
 from vcage.data import DatasetWriter, Feature
 from vcage.pipeline.config import GenerateConfig
