@@ -76,7 +76,8 @@ def generate_cmd(
         out: Path = typer.Option(Path("out/dataset"), help="dataset directory (LeRobot v3 layout)"),
         mode: str = typer.Option("vcage", help="vcage, or vanilla (naive placement, no critic)"),
         planner: str = typer.Option("offline", help="offline or llm"),
-        critic: str = typer.Option("image", help="critic that verifies each subtask: image (offline), vlm (VCAGE_VLM_* env vars), oracle"),
+        critic: str = typer.Option("image", help="critic that verifies each subtask: image "
+                                   "(offline), vlm (VCAGE_VLM_* env vars), oracle"),
         placement: str = typer.Option("context", help="context, naive or rejection"),
         clutter: int = typer.Option(4, min=0, help="distractors per scene"),
         seed: int = typer.Option(0), max_attempts: int = typer.Option(10, min=1),
