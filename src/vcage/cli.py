@@ -124,12 +124,12 @@ def _print_funnel(stats: dict, out: Path) -> None:
             reasons.add_row(reason, str(n))
         console.print(reasons)
     ratio = stats["total_over_physics_and_render"]
+    timing = f"; total / (physics + render) = {ratio:.2f}" if ratio else ""
     console.print(
         f"accepted {stats['accepted']}/{stats['episodes_requested']} episodes in {stats['attempts']} "
         f"attempts ({stats['given_up']} given up); label noise (oracle audit of accepted): "
         f"{stats['label_noise']:.1%}; {stats['wall_seconds']:.1f} s wall, "
-        f"{stats['episodes_per_hour']:.0f} episodes/hour; total / (physics + render) = "
-        f"{ratio:.2f}" if ratio else "")
+        f"{stats['episodes_per_hour']:.0f} episodes/hour{timing}")
     console.print(f"dataset and stats.json in {out}/")
 
 

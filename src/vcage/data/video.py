@@ -13,14 +13,16 @@ from vcage.errors import DatasetError
 
 PIX_FMT = "yuv420p"
 
-# Encoder preference (LeRobot uses SVT-AV1) and fast settings; g=2 keeps frames close to the
-# source and makes seeking cheap, as LeRobot does.
+# Encoder preference and fast settings; g=2 keeps frames close to the source and makes seeking
+# cheap, as LeRobot does. H.264 comes first: SVT-AV1 (LeRobot's default) was seen to deadlock in
+# its thread pool during a long generation run on a 2-core machine, so it is only a fallback,
+# restricted to one thread. Small videos need no more than one encoder thread anyway.
 ENCODER_OPTIONS: dict[str, dict[str, str]] = {
-    "libsvtav1": {"preset": "11", "crf": "30", "g": "2"},
-    "libaom-av1": {"cpu-used": "8", "crf": "30", "g": "2"},
-    "libx264": {"preset": "veryfast", "crf": "20", "g": "2"},
-    "h264": {"preset": "veryfast", "crf": "20", "g": "2"},
-    "mpeg4": {"qmin": "2", "qmax": "4", "g": "2"},
+    "libx264": {"preset": "veryfast", "crf": "20", "g": "2", "threads": "1"},
+    "h264": {"preset": "veryfast", "crf": "20", "g": "2", "threads": "1"},
+    "libsvtav1": {"preset": "11", "crf": "30", "g": "2", "svtav1-params": "lp=1"},
+    "libaom-av1": {"cpu-used": "8", "crf": "30", "g": "2", "threads": "1"},
+    "mpeg4": {"qmin": "2", "qmax": "4", "g": "2", "threads": "1"},
 }
 
 

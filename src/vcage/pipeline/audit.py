@@ -51,8 +51,11 @@ class AuditReport:
                 "precision": self.precision, "recall": self.recall}
 
     def summary(self) -> str:
-        return (f"{self.accepted} accepted episodes of {self.attempts} attempts; label noise "
-                f"{self.label_noise:.1%} ({self.accepted_oracle_failed} accepted episodes fail the oracle)\n"
+        head = (f"{self.accepted} accepted episodes of {self.attempts} attempts; label noise "
+                f"{self.label_noise:.1%} ({self.accepted_oracle_failed} accepted episodes fail the oracle)\n")
+        if not self.judged_subtasks:
+            return head + "no critic verdicts to compare (Vanilla mode, or no subtask was judged)"
+        return (head +
                 f"critic vs oracle on {self.judged_subtasks} judged subtasks: agreement "
                 f"{self.agreement:.1%}, "
                 f"precision {self.precision:.1%}, recall {self.recall:.1%} "

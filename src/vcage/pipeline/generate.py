@@ -129,7 +129,7 @@ def _count(funnel: Funnel, result: Attempt) -> None:
 def _reason_key(reason: str) -> str:
     import re
 
-    return re.sub(r"\d+(\.\d+)?", "N", reason.split(";")[0].split("(")[0]).strip()[:80]
+    return re.sub(r"\d+(\.\d+)?", "N", reason.split(";")[0]).strip()[:90]
 
 
 def _audit(result: Attempt) -> list[dict[str, Any]]:
