@@ -9,6 +9,7 @@ with its oracle audit in ``meta/vcage_attempts.jsonl``; the funnel goes to ``sta
 from __future__ import annotations
 
 import json
+import re
 import time
 from collections import Counter
 from collections.abc import Callable
@@ -127,8 +128,6 @@ def _count(funnel: Funnel, result: Attempt) -> None:
 
 
 def _reason_key(reason: str) -> str:
-    import re
-
     return re.sub(r"\d+(\.\d+)?", "N", reason.split(";")[0]).strip()[:90]
 
 

@@ -20,7 +20,7 @@ from vcage.assets.catalog import CATALOG, ObjectType
 from vcage.errors import PlacementError
 from vcage.registry import Registry
 from vcage.scene.layout import LayoutObject, LayoutSpec, relation_order, validate
-from vcage.scene.placement.geometry import footprint
+from vcage.scene.placement.geometry import footprint, to_world
 from vcage.scene.placement.reach import ReachMap
 from vcage.scene.spec import ObjectSpec, SceneSpec
 
@@ -148,9 +148,7 @@ def support_frame(obj: LayoutObject, poses: dict[str, Pose],
     host = objects[obj.support.obj]
     hp = poses[host.name]
     place = CATALOG.get(host.type).placement(obj.support.placement)
-    c, s = math.cos(hp.yaw), math.sin(hp.yaw)
-    local = np.asarray(place.pos[:2]) * host.scale
-    center = np.asarray(hp.xy) + [c * local[0] - s * local[1], s * local[0] + c * local[1]]
+    center = to_world(hp.xy, hp.yaw, np.asarray(place.pos[:2]) * host.scale)
     return center, hp.yaw, np.asarray(place.half_size) * host.scale
 
 

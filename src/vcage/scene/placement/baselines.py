@@ -9,14 +9,13 @@ after a fixed number of tries the scene fails.
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
 from vcage.assets.catalog import CATALOG
 from vcage.errors import PlacementError
 from vcage.scene.layout import LayoutObject, LayoutSpec, Relation
 from vcage.scene.placement.base import PLACERS, Placer, Pose, support_frame
+from vcage.scene.placement.geometry import to_world
 
 
 class _UniformPlacer(Placer):
@@ -35,9 +34,8 @@ class _UniformPlacer(Placer):
         yaw = float(rng.uniform(*obj.yaw)) if obj.yaw[0] < obj.yaw[1] else obj.yaw[0]
         if not obj.support.is_table:
             center, syaw, half = support_frame(obj, poses, self.objects)
-            u = rng.uniform(-1, 1, 2) * half
-            c, s = math.cos(syaw), math.sin(syaw)
-            return Pose((float(center[0] + c * u[0] - s * u[1]), float(center[1] + s * u[0] + c * u[1])), yaw)
+            x, y = to_world(center, syaw, rng.uniform(-1, 1, 2) * half)
+            return Pose((float(x), float(y)), yaw)
         (x0, x1), (y0, y1) = self.layout.table.x_range, self.layout.table.y_range
         if obj.region is not None:
             rx0, ry0, rx1, ry1 = obj.region.bounds

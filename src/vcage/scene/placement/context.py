@@ -26,11 +26,12 @@ from vcage.errors import PlacementError
 from vcage.scene.layout import LayoutObject, LayoutSpec
 from vcage.scene.placement.base import PLACERS, PlacementStats, Placer, Pose, height, support_frame
 from vcage.scene.placement.free_space import Occupant, SurfaceMap
-from vcage.scene.placement.geometry import erode_box, footprint, sample_point
+from vcage.scene.placement.geometry import erode_box, footprint, rotated_rect, sample_point
 from vcage.scene.spec import ROBOT_MOUNT
 
 FAR = 10.0  # half-planes are boxes this large
 FULL_TURN = (-math.pi, math.pi)
+MIN_HALF = 1e-4  # a support surface is never thinner than this (m), so its polygon has an area
 # Objects put on another one keep their origin over the middle half of its surface, so that a
 # stack of several stays statically stable.
 ON_INSET = 0.5
@@ -111,7 +112,7 @@ class ContextAwarePlacer(Placer):
         label = obj.support.label()
         if label not in self.maps:
             center, yaw, half = support_frame(obj, poses, self.objects)
-            self.maps[label] = SurfaceMap(label, _rect(center, yaw, half))
+            self.maps[label] = SurfaceMap(label, rotated_rect(center, yaw, np.maximum(half, MIN_HALF)))
         return self.maps[label]
 
     def _domain(self, obj: LayoutObject, shape: Polygon, poses: dict[str, Pose]) -> BaseGeometry:
@@ -136,7 +137,7 @@ class ContextAwarePlacer(Placer):
         container the whole footprint stays in it, so the object clears the walls."""
         center, syaw, half = support_frame(obj, poses, self.objects)
         if self._support_kind(obj) == "on":  # the origin stays over the middle of the surface
-            return _rect(center, syaw, half * ON_INSET)
+            return rotated_rect(center, syaw, np.maximum(half * ON_INSET, MIN_HALF))
         local_shape = affinity.rotate(shape, -syaw, origin=(0, 0), use_radians=True)
         local = erode_box((-half[0], -half[1], half[0], half[1]), local_shape)
         if local.is_empty:
@@ -191,13 +192,6 @@ class ContextAwarePlacer(Placer):
             f"{surface.usable.area:.3f} m² {where} is free but no gap fits it (with "
             f"{len(poses)} objects placed, after {self.backtracks} backtracks); use fewer or "
             "smaller objects, a larger table, or a wider region")
-
-
-def _rect(center: np.ndarray, yaw: float, half: np.ndarray) -> Polygon:
-    c, s = math.cos(yaw), math.sin(yaw)
-    hx, hy = max(float(half[0]), 1e-4), max(float(half[1]), 1e-4)
-    return Polygon([(center[0] + x * c - y * s, center[1] + x * s + y * c)
-                    for x, y in ((hx, hy), (-hx, hy), (-hx, -hy), (hx, -hy))])
 
 
 def _relation_region(kind: str, b: tuple[float, float], distance: float) -> BaseGeometry:

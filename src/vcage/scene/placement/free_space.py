@@ -16,7 +16,7 @@ import shapely
 from shapely.geometry import Polygon
 from shapely.geometry.base import BaseGeometry
 
-from vcage.scene.placement.geometry import EMPTY, minkowski_cobstacle
+from vcage.scene.placement.geometry import minkowski_cobstacle
 
 
 @dataclass(frozen=True)
@@ -79,4 +79,4 @@ class SurfaceMap:
         return float(max(0.0, self.usable.area - covered.area))
 
 
-__all__ = ["EMPTY", "Clearance", "Occupant", "SurfaceMap"]
+__all__ = ["Clearance", "Occupant", "SurfaceMap"]

@@ -8,6 +8,7 @@ the Minkowski sum ``O ⊕ (−F)``; for convex polygons that is the convex hull 
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 
 import numpy as np
 import shapely
@@ -17,17 +18,27 @@ from shapely.geometry.base import BaseGeometry
 from vcage.assets.catalog import CATALOG
 
 EMPTY = Polygon()
+Vec2 = Sequence[float] | np.ndarray  # an (x, y) pair
 
 
 def footprint(type_name: str, scale: float, yaw: float, xy: tuple[float, float] = (0.0, 0.0),
               pad: float = 0.0) -> Polygon:
     """The object's resting rectangle (its size box, grown by ``pad``) at ``xy`` and ``yaw``."""
     sx, sy = (s * scale for s in CATALOG.get(type_name).size[:2])
-    hx, hy = sx / 2 + pad, sy / 2 + pad
+    return rotated_rect(xy, yaw, (sx / 2 + pad, sy / 2 + pad))
+
+
+def to_world(center: Vec2, yaw: float, local: Vec2) -> np.ndarray:
+    """The world (x, y) of ``local``, given in a frame at ``center`` turned by ``yaw``."""
     c, s = math.cos(yaw), math.sin(yaw)
-    corners = [(x * c - y * s + xy[0], x * s + y * c + xy[1])
-               for x, y in ((hx, hy), (-hx, hy), (-hx, -hy), (hx, -hy))]
-    return Polygon(corners)
+    return np.asarray(center[:2], dtype=float) + [c * local[0] - s * local[1], s * local[0] + c * local[1]]
+
+
+def rotated_rect(center: Vec2, yaw: float, half: Vec2) -> Polygon:
+    """The rectangle with half extents ``half`` centred at ``center`` and turned by ``yaw``."""
+    hx, hy = float(half[0]), float(half[1])
+    return Polygon([tuple(to_world(center, yaw, corner))
+                    for corner in ((hx, hy), (-hx, hy), (-hx, -hy), (hx, -hy))])
 
 
 def minkowski_cobstacle(obstacle: Polygon, shape: Polygon) -> Polygon:
