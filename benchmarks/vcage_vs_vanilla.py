@@ -9,16 +9,20 @@ episodes per core-hour (accepted episodes the oracle confirms, per hour of one c
 ratio of total time to physics plus rendering.
 
     LP_NUM_THREADS=1 .venv/bin/python benchmarks/vcage_vs_vanilla.py --episodes 50 --workers 2
+
+The datasets are kept under ``--out`` (one per goal and mode, auditable with ``vcage audit``), and
+each finished job's row is appended to ``--out/results.jsonl``; a rerun with the same arguments
+skips the jobs already there, so a long run can be stopped and resumed.
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import os
 import shutil
-import tempfile
 import time
-from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures import ProcessPoolExecutor, as_completed
 from pathlib import Path
 
 os.environ.setdefault("LP_NUM_THREADS", "1")  # one rasteriser thread: a worker is one core
@@ -42,7 +46,8 @@ def _run(job: tuple[str, str, int, int, str]) -> dict:
     wall = time.perf_counter() - t0
     report = audit(out)
     stats = funnel.to_dict()
-    return {"goal": goal, "mode": mode, "attempts": funnel.attempts, "accepted": funnel.accepted,
+    return {"goal": goal, "mode": mode, "episodes": episodes, "seed": seed,
+            "attempts": funnel.attempts, "accepted": funnel.accepted,
             "noisy": funnel.accepted_oracle_failed, "judged": report.judged_subtasks,
             "tp": report.true_accept, "fp": report.false_accept, "fn": report.false_reject,
             "tn": report.true_reject, "wall": wall, "physics": funnel.timing.physics,
@@ -71,16 +76,30 @@ def main() -> None:
     parser.add_argument("--goals", nargs="*", default=list(DEFAULT_GOALS))
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--out", default="out/benchmarks/vcage_vs_vanilla",
+                        help="where the datasets and results.jsonl go")
     args = parser.parse_args()
-    root = tempfile.mkdtemp(prefix="vcage-vs-vanilla-")
-    jobs = [(g, m, args.episodes, args.seed, root) for g in args.goals for m in ("vcage", "vanilla")]
+    root = Path(args.out)
+    root.mkdir(parents=True, exist_ok=True)
+    results = root / "results.jsonl"
+    done = [json.loads(line) for line in results.read_text().splitlines()] if results.exists() else []
+    done = [r for r in done if r["episodes"] == args.episodes and r["seed"] == args.seed]
+    have = {(r["goal"], r["mode"]) for r in done}
+    jobs = [(g, m, args.episodes, args.seed, str(root)) for g in args.goals
+            for m in ("vcage", "vanilla") if (g, m) not in have]
+    rows = [r for r in done if r["goal"] in args.goals]
     t0 = time.perf_counter()
     with ProcessPoolExecutor(args.workers) as pool:
-        rows = list(pool.map(_run, jobs))
+        for future in as_completed([pool.submit(_run, job) for job in jobs]):
+            row = future.result()
+            rows.append(row)
+            with results.open("a") as f:
+                f.write(json.dumps(row) + "\n")
+            print(f"done {row['goal']} / {row['mode']}: {row['accepted']} accepted of "
+                  f"{row['attempts']} attempts in {row['wall']:.0f} s", flush=True)
     wall = time.perf_counter() - t0
-    shutil.rmtree(root, ignore_errors=True)
     print(f"{args.episodes} accepted episodes per goal and mode, same seeds, two 128x128 cameras; "
-          f"{wall:.0f} s wall on {args.workers} workers (one core each)\n")
+          f"{wall:.0f} s wall for {len(jobs)} new jobs on {args.workers} workers (one core each)\n")
     print(f"{'goal / mode':24s} {'acc':>4s} {'noise':>7s} {'reject':>7s} {'agree':>6s} {'prec':>6s} "
           f"{'recall':>6s} {'verif/c-h':>9s} {'t/(p+r)':>6s}")
     for goal in args.goals:
