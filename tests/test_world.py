@@ -30,6 +30,14 @@ def test_state_restore_replays_exactly(world: World) -> None:
     np.testing.assert_array_equal(world.data.qpos, first)
 
 
+def test_physics_time_is_counted_per_step(world: World) -> None:
+    start = world.physics_seconds
+    world.forward()
+    assert world.physics_seconds == start  # only stepping counts as physics
+    world.settle(0.1)
+    assert world.physics_seconds > start
+
+
 def test_instability_is_detected(world: World) -> None:
     world.data.qvel[world.model.joint("a/free").dofadr[0]] = 1e6
     with pytest.raises(SimulationError, match="a/free"):

@@ -35,6 +35,9 @@ def test_generate_writes_a_verified_dataset(tmp_path: Path) -> None:
     assert reader.video(0, "observation.images.front").shape == (ep.length, 64, 64, 3)
     stats = json.loads((out / STATS_FILE).read_text())
     assert stats["accepted"] == 1 and stats["stages"]["accepted"] == 1
+    seconds = stats["seconds"]
+    assert seconds["physics"] > 0 and seconds["render"] > 0
+    assert seconds["physics"] + seconds["render"] <= stats["wall_seconds"]
     report = audit(out)
     assert report.accepted == 1 and report.agreement == 1.0 and report.judged_subtasks == 2
 

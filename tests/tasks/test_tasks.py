@@ -5,8 +5,11 @@ import pytest
 
 from vcage.config import Randomization
 from vcage.errors import RegistryError
+from vcage.sim.world import World
+from vcage.skills.executor import Executor
+from vcage.skills.primitives import Skills
 from vcage.tasks.base import TASKS
-from vcage.tasks.runner import make_task, run_episode
+from vcage.tasks.runner import held, make_task, run_episode
 
 make_task("stack_blocks_two")  # registers the library
 ALL_TASKS = TASKS.names()
@@ -14,6 +17,20 @@ ALL_TASKS = TASKS.names()
 
 def test_library_has_at_least_fifteen_tasks() -> None:
     assert len(ALL_TASKS) >= 15
+
+
+def test_held_needs_consecutive_steps_not_one_frame(world: World) -> None:
+    calls = iter(range(100))
+
+    def check() -> dict[str, bool]:
+        i = next(calls)
+        return {"steady": True, "flicker": i % 2 == 0, "late": i >= 4, "too_late": i >= 5}
+
+    skills = Skills(world, Executor(world))
+    holds, last = held(skills, check, steps=4)
+    assert holds == {"steady": True, "flicker": False, "late": True, "too_late": False}
+    assert last == {"steady": True, "flicker": False, "late": True, "too_late": True}
+    assert len(skills.executor.recording) == 8  # 2 * steps control steps were recorded
 
 
 def test_unknown_task_lists_valid_names() -> None:

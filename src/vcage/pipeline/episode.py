@@ -68,23 +68,6 @@ class Attempt:
                     and len(self.rollout.outcomes) > 0)
 
 
-class _TimedWorld:
-    """Accumulates the wall time of ``World.step`` (physics) for one attempt."""
-
-    def __init__(self, world: World, timing: Timing) -> None:
-        self.world, self.timing = world, timing
-        self._step = world.step
-
-        def timed(ctrl: np.ndarray | None = None) -> None:
-            t0 = time.perf_counter()
-            try:
-                self._step(ctrl)
-            finally:
-                timing.physics += time.perf_counter() - t0
-
-        world.step = timed  # type: ignore[method-assign]
-
-
 def attempt(plan: Plan, seed: int, cfg: GenerateConfig, critic: Critic | None) -> Attempt:
     t_start = time.perf_counter()
     timing = Timing()
@@ -103,7 +86,17 @@ def _attempt(plan: Plan, seed: int, cfg: GenerateConfig, critic: Critic | None, 
         return Attempt(seed, "placement", str(exc))
     try:
         world = compose(scene).make_world()
-        _TimedWorld(world, timing)
+    except SimulationError as exc:
+        return Attempt(seed, "physics", str(exc), scene)
+    try:
+        return _execute(plan, seed, cfg, critic, timing, scene, world)
+    finally:
+        timing.physics += world.physics_seconds
+
+
+def _execute(plan: Plan, seed: int, cfg: GenerateConfig, critic: Critic | None, timing: Timing,
+             scene: SceneSpec, world: World) -> Attempt:
+    try:
         if cfg.check_scene:
             report = check_stability(world, StabilityConfig(settle_seconds=SETTLE_SECONDS))
             if not report.ok:

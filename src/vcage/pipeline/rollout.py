@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from functools import partial
 from typing import Any
 
 from vcage.critics.oracle import Oracle
@@ -16,6 +17,7 @@ from vcage.errors import SkillError
 from vcage.planning.schema import Plan, Subtask
 from vcage.sim.world import World
 from vcage.skills.primitives import Skills
+from vcage.tasks.runner import held
 
 HOLD_STEPS = 5  # the oracle's predicates must hold this many consecutive control steps
 
@@ -63,7 +65,7 @@ def run_plan(world: World, plan: Plan, skills: Skills | None = None, judge: Judg
             skills.do("retreat")  # back home: the views after the subtask show it unobstructed
         except SkillError as exc:
             error = str(exc)
-        values = _held(world, skills, oracle, sub)
+        values, _ = held(skills, partial(oracle.check, world, sub), HOLD_STEPS)
         outcome = SubtaskOutcome(i, sub.skill, sub.description, start, len(skills.executor.recording),
                                  values, error is None and all(values.values()), error)
         rollout.outcomes.append(outcome)
@@ -83,13 +85,3 @@ def _skill_args(sub: Subtask) -> dict[str, Any]:
     if isinstance(args.get("xy"), list):
         args["xy"] = tuple(args["xy"])
     return args
-
-
-def _held(world: World, skills: Skills, oracle: Oracle, sub: Subtask) -> dict[str, bool]:
-    streak: dict[str, int] = {}
-    values: dict[str, bool] = {}
-    for _ in range(HOLD_STEPS * 2):
-        skills.executor.wait(world.control_dt)
-        values = oracle.check(world, sub)
-        streak = {k: (streak.get(k, 0) + 1 if v else 0) for k, v in values.items()}
-    return {k: streak[k] >= HOLD_STEPS for k in values}

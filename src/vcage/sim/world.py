@@ -6,6 +6,7 @@ it appears, so an unstable rollout is never recorded.
 
 from __future__ import annotations
 
+import time
 from dataclasses import dataclass
 
 import mujoco
@@ -43,6 +44,7 @@ class World:
         self.objects = objects
         self.robot = Robot(model)
         self.substeps = sim.substeps
+        self.physics_seconds = 0.0  # wall time spent in step(), to relate a run's total to physics
         self._root_to_object = np.full(model.nbody, -1, dtype=np.int32)
         self.object_names = list(objects)
         for idx, inst in enumerate(objects.values()):
@@ -75,11 +77,14 @@ class World:
         """Apply ``ctrl`` (if given) and advance one control period; raise if unstable."""
         if ctrl is not None:
             self.data.ctrl[:] = ctrl
+        t0 = time.perf_counter()
         before = self._bad_state_warnings()
         try:
             mujoco.mj_step(self.model, self.data, nstep=self.substeps)
         except mujoco.FatalError as exc:
             raise SimulationError(_fatal_message(exc)) from exc
+        finally:
+            self.physics_seconds += time.perf_counter() - t0
         if self._bad_state_warnings() > before:  # MuJoCo reset the data after NaN/Inf/huge values
             raise SimulationError(
                 f"simulation unstable near t={self.data.time:.3f}s: MuJoCo found NaN, Inf or huge "

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
@@ -89,12 +90,23 @@ def run_episode(name: str, seed: int, rand: Randomization | None = None,
                          skills.executor.recording, initial, world, error)
 
 
+def held(skills: Skills, check: Callable[[], dict[str, Any]],
+         steps: int) -> tuple[dict[str, bool], dict[str, Any]]:
+    """Keep the last command for ``2 * steps`` control steps, calling ``check`` after each.
+
+    Returns, per key of ``check``'s dict, whether its value was true on the last ``steps``
+    consecutive calls, and the last dict itself: success must hold, not flicker for one frame.
+    """
+    streak: dict[str, int] = {}
+    values: dict[str, Any] = {}
+    for _ in range(steps * 2):
+        skills.executor.wait(skills.world.control_dt)
+        values = check()
+        streak = {k: streak.get(k, 0) + 1 if v else 0 for k, v in values.items()}
+    return {k: streak[k] >= steps for k in values}, values
+
+
 def held_success(task: AtomicTask, skills: Skills) -> tuple[bool, dict[str, Any]]:
     """Keep the last command for a moment; success must hold on ``hold_steps`` consecutive steps."""
-    streak = 0
-    info: dict[str, Any] = {}
-    for _ in range(task.hold_steps * 2):
-        skills.executor.wait(skills.world.control_dt)
-        info = task.evaluate(skills.world)
-        streak = streak + 1 if info["success"] else 0
-    return streak >= task.hold_steps, info
+    holds, info = held(skills, lambda: task.evaluate(skills.world), task.hold_steps)
+    return holds["success"], info
