@@ -1,5 +1,8 @@
 """A local HTTP server speaking OpenAI's chat-completions protocol, driven by a script.
 
+The protocol lives in four methods (``serves``, ``listing``, ``success``, ``error``); ``fake_gemini``
+overrides them to speak Gemini's ``generateContent`` with the same scripting.
+
 Use from any test (``tests/`` is on ``sys.path`` through ``tests/conftest.py``)::
 
     from backends.fake_openai import FakeOpenAI, Reply, Status, Delay
@@ -51,6 +54,7 @@ class Status:
     message: str = "scripted error"
     retry_after: str | None = None
     retry_after_ms: str | None = None
+    retry_delay: str | None = None  # Gemini only: a google.rpc.RetryInfo detail, e.g. "0.2s"
 
 
 @dataclass(frozen=True)
@@ -121,6 +125,24 @@ class FakeOpenAI:
     def _sleep(self, seconds: float) -> None:
         self._closing.wait(seconds)
 
+    # The protocol: subclasses for other providers override these four.
+    def serves(self, path: str) -> bool:
+        """Whether ``POST path`` is a chat request."""
+        return path.rstrip("/") == "/v1/chat/completions"
+
+    def listing(self, path: str) -> dict[str, Any] | None:
+        """The answer to ``GET path``, or None for 404."""
+        if path.rstrip("/") != "/v1/models":
+            return None
+        data = [{"id": self.model, "object": "model", "created": 0, "owned_by": "fake-openai"}]
+        return {"object": "list", "data": data}
+
+    def success(self, path: str, body: dict[str, Any], reply: Reply) -> dict[str, Any]:
+        return completion(str(body.get("model", self.model)), reply)
+
+    def error(self, status: int, message: str, retry_delay: str | None = None) -> dict[str, Any]:
+        return error_body(status, message)
+
 
 def completion(model: str, reply: Reply) -> dict[str, Any]:
     """A chat.completion object in OpenAI's response schema."""
@@ -150,21 +172,21 @@ def _handler_class(server: FakeOpenAI) -> type[BaseHTTPRequestHandler]:
             pass
 
         def do_GET(self) -> None:  # noqa: N802 - http.server naming
-            if self.path.rstrip("/") == "/v1/models":
-                data = [{"id": server.model, "object": "model", "created": 0, "owned_by": "fake-openai"}]
-                self._send(200, {"object": "list", "data": data})
+            listing = server.listing(self.path)
+            if listing is None:
+                self._send(404, server.error(404, f"no route GET {self.path}"))
             else:
-                self._send(404, error_body(404, f"no route GET {self.path}"))
+                self._send(200, listing)
 
         def do_POST(self) -> None:  # noqa: N802 - http.server naming
             raw = self.rfile.read(int(self.headers.get("Content-Length") or 0))
-            if self.path.rstrip("/") != "/v1/chat/completions":
-                self._send(404, error_body(404, f"no route POST {self.path}"))
+            if not server.serves(self.path):
+                self._send(404, server.error(404, f"no route POST {self.path}"))
                 return
             try:
                 body = json.loads(raw)
             except ValueError:
-                self._send(400, error_body(400, "request body is not valid JSON"))
+                self._send(400, server.error(400, "request body is not valid JSON"))
                 return
             item = server._next(body, {k.lower(): v for k, v in self.headers.items()})
             self._answer(item, body)
@@ -172,17 +194,18 @@ def _handler_class(server: FakeOpenAI) -> type[BaseHTTPRequestHandler]:
         def _answer(self, item: Item | None, body: dict[str, Any]) -> None:
             if item is None:
                 n = len(server.requests)
-                msg = f"FakeOpenAI: script is empty at request #{n}; script one response per expected request"
-                self._send(500, error_body(500, msg))
+                msg = (f"{type(server).__name__}: script is empty at request #{n}; script one response "
+                       "per expected request")
+                self._send(500, server.error(500, msg))
             elif isinstance(item, Delay):
                 server._sleep(item.seconds)
                 self._answer(item.then, body)
             elif isinstance(item, Status):
                 headers = {"Retry-After": item.retry_after, "retry-after-ms": item.retry_after_ms}
-                self._send(item.status, error_body(item.status, item.message), headers)
+                self._send(item.status, server.error(item.status, item.message, item.retry_delay), headers)
             elif isinstance(item, (str, Reply)):
                 reply = Reply(item) if isinstance(item, str) else item
-                self._send(200, completion(str(body.get("model", server.model)), reply))
+                self._send(200, server.success(self.path, body, reply))
             else:
                 self._answer(item(body), body)
 

@@ -6,20 +6,25 @@ import io
 import math
 import os
 import threading
+import time
 from abc import ABC, abstractmethod
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import asdict, dataclass, field, fields
-from typing import Any, ClassVar
+from typing import Any, ClassVar, TypeVar
 from urllib.parse import urlsplit
 
 import numpy as np
 
-from vcage.errors import ConfigError, MissingAPIKeyError
+from vcage.errors import BackendError, BackendTimeout, ConfigError, MissingAPIKeyError
 from vcage.registry import Registry
 
 ROLES = ("system", "user", "assistant")
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 LOCAL_HOSTS = frozenset({"localhost", "127.0.0.1", "::1"})
+T = TypeVar("T")
+# provider -> (default base_url, default API key variable)
+PROVIDERS = {"openai": ("http://localhost:8000/v1", "OPENAI_API_KEY"),
+             "gemini": ("https://generativelanguage.googleapis.com", "GEMINI_API_KEY")}
 LOCAL_PLACEHOLDER_KEY = "EMPTY"  # what vLLM / Ollama / LM Studio accept when they run without auth
 
 
@@ -78,8 +83,9 @@ class BackendConfig:
 
     base_url: str
     model: str
+    provider: str = "openai"  # the registered backend that speaks to base_url: openai or gemini
     api_key: str | None = field(default=None, repr=False, compare=False)
-    api_key_env: str = "OPENAI_API_KEY"
+    api_key_env: str = ""  # default: the provider's usual variable, OPENAI_API_KEY or GEMINI_API_KEY
     timeout: float = 30.0  # seconds per attempt
     max_retries: int = 3  # retries after the first attempt
     backoff: float = 0.5  # seconds; wait before retry n is backoff * 2**n
@@ -93,9 +99,13 @@ class BackendConfig:
             raise ConfigError(
                 f"base_url {self.base_url!r} must be an http(s) URL with a host, e.g. http://localhost:8000/v1"
             )
+        if not isinstance(self.provider, str) or self.provider not in PROVIDERS:
+            raise ConfigError(f"provider {self.provider!r} is unknown; use one of {sorted(PROVIDERS)}")
         if not isinstance(self.model, str) or not self.model.strip():
             raise ConfigError("model must be a non-empty model name as served by the endpoint")
         if not self.api_key_env:
+            object.__setattr__(self, "api_key_env", PROVIDERS[self.provider][1])
+        if not isinstance(self.api_key_env, str):
             raise ConfigError("api_key_env must name an environment variable, e.g. OPENAI_API_KEY")
         _check_number("timeout", self.timeout, low=0.0, strict=True)
         _check_number("backoff", self.backoff, low=0.0)
@@ -113,10 +123,6 @@ class BackendConfig:
     def is_local(self) -> bool:
         """True when ``base_url`` points at this machine, where servers usually run without a key."""
         return _is_local(self.base_url)
-
-    @property
-    def endpoint(self) -> str:
-        return self.base_url.rstrip("/") + "/chat/completions"
 
     def resolve_api_key(self, environ: Mapping[str, str] | None = None) -> str:
         """The key to send: ``api_key``, else ``$api_key_env``, else a placeholder for local servers."""
@@ -155,19 +161,25 @@ class BackendConfig:
         environ: Mapping[str, str] | None = None,
         **overrides: Any,
     ) -> BackendConfig:
-        """Read ``{prefix}_BASE_URL``, ``{prefix}_MODEL`` and ``{prefix}_API_KEY``.
+        """Read ``{prefix}_PROVIDER``, ``{prefix}_BASE_URL``, ``{prefix}_MODEL`` and ``{prefix}_API_KEY``.
 
-        ``VCAGE_LLM_BASE_URL`` defaults to ``http://localhost:8000/v1`` (vLLM's default);
-        ``VCAGE_LLM_MODEL`` is required. When ``VCAGE_LLM_API_KEY`` is set, ``api_key_env`` names it,
-        so the key is read from the environment when a request is made and never stored in the config;
-        otherwise ``OPENAI_API_KEY`` is used. ``overrides`` set any other field.
+        ``VCAGE_LLM_PROVIDER`` is ``openai`` (default: any OpenAI-compatible server) or ``gemini``.
+        ``VCAGE_LLM_BASE_URL`` defaults to the provider's usual address (``http://localhost:8000/v1``,
+        vLLM's default, for openai; Google's API for gemini); ``VCAGE_LLM_MODEL`` is required. When
+        ``VCAGE_LLM_API_KEY`` is set, ``api_key_env`` names it, so the key is read from the
+        environment when a request is made and never stored in the config; otherwise the
+        provider's usual variable is used (``OPENAI_API_KEY``, ``GEMINI_API_KEY``). ``overrides``
+        set any other field.
         """
         env = os.environ if environ is None else environ
-        base_url = env.get(f"{prefix}_BASE_URL") or "http://localhost:8000/v1"
+        provider = overrides.pop("provider", None) or env.get(f"{prefix}_PROVIDER") or "openai"
+        if provider not in PROVIDERS:
+            raise ConfigError(f"{prefix}_PROVIDER={provider!r} is unknown; use one of {sorted(PROVIDERS)}")
+        base_url = env.get(f"{prefix}_BASE_URL") or PROVIDERS[provider][0]
         model = env.get(f"{prefix}_MODEL")
         if not model and "model" not in overrides:
             raise ConfigError(f"set {prefix}_MODEL to the model name served at {base_url}")
-        data: dict[str, Any] = {"base_url": base_url, "model": model}
+        data: dict[str, Any] = {"base_url": base_url, "model": model, "provider": provider}
         if env.get(f"{prefix}_API_KEY"):
             data["api_key_env"] = f"{prefix}_API_KEY"
         data.update(overrides)
@@ -201,21 +213,105 @@ class Usage:
         return asdict(self)
 
 
+@dataclass(frozen=True)
+class Failure:
+    """How a failed request is handled: whether to retry, its HTTP status, what went wrong."""
+
+    retry: bool
+    detail: str
+    status: int | None = None
+    wait: float | None = None  # seconds the server asked to wait before retrying
+    timed_out: bool = False
+
+
 class ChatBackend(ABC):
-    """Sends chat messages to a model and returns the reply text."""
+    """Sends chat messages to a model and returns the reply text.
+
+    Subclasses make one request in :meth:`chat` through :meth:`_send`, which retries what
+    :meth:`_failure` says is worth retrying (timeouts, connection errors, 429, 5xx) with exponential
+    backoff or the server's requested wait, capped by ``max_backoff``, and counts it all in ``usage``.
+    """
 
     name: ClassVar[str] = "base"
+    not_found_hint: ClassVar[str] = "check base_url and the model name"
 
-    def __init__(self) -> None:
+    def __init__(self, config: BackendConfig) -> None:
+        self.config = config
         self.usage = Usage()
         self._usage_lock = threading.Lock()
+
+    @property
+    @abstractmethod
+    def endpoint(self) -> str:
+        """The URL chat requests go to, for messages and errors."""
 
     @abstractmethod
     def chat(self, messages: Sequence[Message], *, json_mode: bool = False) -> str:
         """The model's reply to ``messages``; ``json_mode`` asks the server for a JSON object."""
 
+    @abstractmethod
+    def _failure(self, exc: Exception) -> Failure | None:
+        """How to handle ``exc`` raised by a request; None for errors that are not the transport's."""
+
     def close(self) -> None:
         """Release connections; the default has nothing to release."""
+
+    def _send(self, request: Callable[[], T]) -> T:
+        cfg = self.config
+        attempts = cfg.max_retries + 1
+        for attempt in range(attempts):
+            self._count(requests=1)
+            try:
+                return request()
+            except Exception as exc:
+                failure = self._failure(exc)
+                if failure is None:
+                    raise
+                if not failure.retry or attempt + 1 == attempts:
+                    self._count(failures=1)
+                    raise self._error(failure, attempt + 1) from exc
+            backoff = cfg.backoff * 2**attempt if failure.wait is None else failure.wait
+            wait = min(cfg.max_backoff, backoff)
+            self._count(retries=1, wait_s=wait)
+            time.sleep(wait)
+        raise AssertionError("unreachable")  # pragma: no cover
+
+    def _error(self, failure: Failure, attempts: int) -> BackendError:
+        cfg = self.config
+        tries = f"after {attempts} attempt{'s' if attempts != 1 else ''}"
+        where = f"chat request to {self.endpoint} (model {cfg.model!r})"
+        if failure.timed_out:
+            return BackendTimeout(
+                f"{where} timed out {tries} (timeout {cfg.timeout} s each); raise timeout or max_retries, "
+                f"or check the server at {cfg.base_url} is not overloaded",
+                endpoint=self.endpoint, model=cfg.model,
+            )
+        detail = failure.detail if failure.status is None else f"HTTP {failure.status}: {failure.detail}"
+        return BackendError(f"{where} failed {tries}: {detail}; {self._hint(failure.status)}",
+                            endpoint=self.endpoint, model=cfg.model, status=failure.status)
+
+    def _hint(self, status: int | None) -> str:
+        cfg = self.config
+        if status in (401, 403):
+            return f"check the API key in ${cfg.api_key_env} (or api_key) is valid for this endpoint"
+        if status == 404:
+            return self.not_found_hint
+        if status == 429:
+            return "the server is rate limiting: lower concurrency or raise max_retries/backoff"
+        if status is not None and status >= 500:
+            return "the server failed: check its logs and that the model is loaded"
+        if status is not None:
+            return ("the server rejected the request: check the model supports these messages, images "
+                    "and json_mode")
+        return f"check the server is running and reachable at {cfg.base_url}"
+
+    def _no_content(self, response: Any) -> BackendError:
+        cfg = self.config
+        return BackendError(
+            f"chat request to {self.endpoint} (model {cfg.model!r}) returned no message content "
+            f"(response: {str(response)[:300]}); check the model produces text for this prompt",
+            endpoint=self.endpoint, model=cfg.model, status=200,
+        )
 
     def _count(self, **increments: float) -> None:
         with self._usage_lock:
@@ -236,3 +332,8 @@ BACKENDS: Registry[BackendFactory] = Registry("backend")
 def make_backend(name: str, config: BackendConfig) -> ChatBackend:
     """Build the backend registered as ``name``; unknown names list the valid ones."""
     return BACKENDS.get(name)(config)
+
+
+def connect(config: BackendConfig) -> ChatBackend:
+    """Build the backend for ``config.provider``."""
+    return make_backend(config.provider, config)

@@ -14,7 +14,7 @@ import re
 from dataclasses import dataclass
 from typing import Any
 
-from vcage.backends import BackendConfig, ChatBackend, Message, make_backend
+from vcage.backends import BackendConfig, ChatBackend, Message, connect
 from vcage.critics.base import CRITICS, Critic, Observation, Verdict
 from vcage.errors import BackendError, ConfigError
 
@@ -99,7 +99,7 @@ def parse_answer(reply: str) -> dict[str, Any] | None:
 
 
 def _from_env(**kw: Any) -> VLMCritic:
-    backend = kw.get("backend") or make_backend("openai", BackendConfig.from_env("VCAGE_VLM"))
+    backend = kw.get("backend") or connect(BackendConfig.from_env("VCAGE_VLM"))
     return VLMCritic(backend, kw.get("config"))
 
 

@@ -10,7 +10,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Protocol
 
-from vcage.backends import BackendConfig, make_backend
+from vcage.backends import BackendConfig, connect
 from vcage.planning.llm import LLMPlanner
 from vcage.planning.offline import OfflinePlanner
 from vcage.planning.schema import Plan
@@ -26,7 +26,7 @@ class Planner(Protocol):
 PlannerFactory = Callable[[BackendConfig | None], Planner]
 PLANNERS: Registry[PlannerFactory] = Registry("planner")
 PLANNERS.add("offline", lambda cfg: OfflinePlanner())
-PLANNERS.add("llm", lambda cfg: LLMPlanner(make_backend("openai", cfg or BackendConfig.from_env())))
+PLANNERS.add("llm", lambda cfg: LLMPlanner(connect(cfg or BackendConfig.from_env())))
 
 
 def make_planner(name: str = "offline", backend: BackendConfig | None = None) -> Planner:
