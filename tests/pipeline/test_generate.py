@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from vcage.data import DatasetReader
-from vcage.errors import DatasetError, PlanningError
+from vcage.errors import ConfigError, DatasetError, PlanningError
 from vcage.pipeline.audit import audit
 from vcage.pipeline.config import GenerateConfig
 from vcage.pipeline.generate import ATTEMPTS_LOG, STATS_FILE, generate
@@ -50,6 +50,25 @@ def test_same_seed_same_episode_and_replayable_states(tmp_path: Path) -> None:
     ea, eb = DatasetReader(a).episode(0), DatasetReader(b).episode(0)
     np.testing.assert_array_equal(ea.frames["action"], eb.frames["action"])
     assert ea.extras["seed"] == eb.extras["seed"] and ea.extras["scene"] == eb.extras["scene"]
+
+
+def test_workers_make_the_same_dataset(tmp_path: Path) -> None:
+    cfg = GenerateConfig(**SMALL)
+    one = generate(SHORT, 2, tmp_path / "one", cfg)
+    two = generate(SHORT, 2, tmp_path / "two", cfg, workers=2)
+    assert (one.accepted, one.attempts) == (two.accepted, two.attempts) and two.workers == 2
+    a, b = DatasetReader(tmp_path / "one"), DatasetReader(tmp_path / "two")
+    for k in range(2):
+        assert a.extras(k)["seed"] == b.extras(k)["seed"]
+        np.testing.assert_array_equal(a.episode(k).arrays["states"], b.episode(k).arrays["states"])
+        np.testing.assert_array_equal(a.video(k, "observation.images.front"),
+                                      b.video(k, "observation.images.front"))
+    logs = [(tmp_path / d / ATTEMPTS_LOG).read_text().splitlines() for d in ("one", "two")]
+    assert [json.loads(r)["seed"] for r in logs[0]] == [json.loads(r)["seed"] for r in logs[1]]
+    stats = json.loads((tmp_path / "two" / STATS_FILE).read_text())
+    assert stats["core_seconds"] == pytest.approx(2 * stats["wall_seconds"], rel=0.01)
+    with pytest.raises(ConfigError, match="workers"):
+        generate(SHORT, 1, tmp_path / "bad", cfg, workers=0)
 
 
 def test_append_needs_the_same_config_and_keeps_episodes(tmp_path: Path) -> None:
