@@ -223,6 +223,11 @@ class Failure:
     wait: float | None = None  # seconds the server asked to wait before retrying
     timed_out: bool = False
 
+    @classmethod
+    def http(cls, status: int, detail: str, wait: float | None = None) -> Failure:
+        """An HTTP error: 429 and 5xx are retried; other statuses will not improve by retrying."""
+        return cls(retry=status == 429 or status >= 500, detail=detail, status=status, wait=wait)
+
 
 class ChatBackend(ABC):
     """Sends chat messages to a model and returns the reply text.
@@ -305,9 +310,13 @@ class ChatBackend(ABC):
                     "and json_mode")
         return f"check the server is running and reachable at {cfg.base_url}"
 
-    def _no_content(self, response: Any) -> BackendError:
+    def _reply(self, response: Any, text: str | None, prompt_tokens: int, completion_tokens: int) -> str:
+        """Count the tokens a response reports and return its text; no text is an error."""
+        self._count(prompt_tokens=prompt_tokens, completion_tokens=completion_tokens)
+        if isinstance(text, str) and text:
+            return text
         cfg = self.config
-        return BackendError(
+        raise BackendError(
             f"chat request to {self.endpoint} (model {cfg.model!r}) returned no message content "
             f"(response: {str(response)[:300]}); check the model produces text for this prompt",
             endpoint=self.endpoint, model=cfg.model, status=200,

@@ -84,15 +84,11 @@ Registered as ``gemini`` in ``vcage.backends``, which imports this module only w
         response = self._send(lambda: self._client.models.generate_content(
             model=cfg.model, contents=turns, config=generation))
         usage = response.usage_metadata
-        if usage is not None:
-            self._count(prompt_tokens=usage.prompt_token_count or 0,
-                        completion_tokens=usage.candidates_token_count or 0)
         candidates = response.candidates or []
         content = candidates[0].content if candidates else None
         text = "".join(p.text or "" for p in (content.parts or [])) if content is not None else ""
-        if not text:
-            raise self._no_content(response)
-        return text
+        return self._reply(response, text, getattr(usage, "prompt_token_count", 0) or 0,
+                           getattr(usage, "candidates_token_count", 0) or 0)
 
     def _failure(self, exc: Exception) -> Failure | None:
         if isinstance(exc, httpx2.TimeoutException):
@@ -100,9 +96,8 @@ Registered as ``gemini`` in ``vcage.backends``, which imports this module only w
         if isinstance(exc, httpx2.TransportError):
             return Failure(retry=True, detail=f"connection failed ({exc})")
         if isinstance(exc, errors.APIError):
-            status = exc.code
             headers = getattr(exc.response, "headers", None)
             wait = retry_after_seconds(headers) if headers is not None else None
-            return Failure(retry=status == 429 or status >= 500, detail=str(exc.message or exc),
-                           status=status, wait=wait if wait is not None else retry_delay_seconds(exc.details))
+            return Failure.http(exc.code, str(exc.message or exc),
+                                wait if wait is not None else retry_delay_seconds(exc.details))
         return None

@@ -99,14 +99,10 @@ class OpenAIChatBackend(ChatBackend):
             request["response_format"] = {"type": "json_object"}
         response = self._send(lambda: self._client.chat.completions.create(**request))
         usage = getattr(response, "usage", None)
-        if usage is not None:
-            self._count(prompt_tokens=usage.prompt_tokens or 0,
-                        completion_tokens=usage.completion_tokens or 0)
         choices = getattr(response, "choices", None)
-        content = choices[0].message.content if choices else None
-        if not isinstance(content, str) or not content:
-            raise self._no_content(response)
-        return content
+        return self._reply(response, choices[0].message.content if choices else None,
+                           getattr(usage, "prompt_tokens", 0) or 0,
+                           getattr(usage, "completion_tokens", 0) or 0)
 
     def _failure(self, exc: Exception) -> Failure | None:
         if isinstance(exc, openai.APITimeoutError):
@@ -114,9 +110,8 @@ class OpenAIChatBackend(ChatBackend):
         if isinstance(exc, openai.APIConnectionError):
             return Failure(retry=True, detail=f"connection failed ({exc.__cause__ or exc})")
         if isinstance(exc, openai.APIStatusError):
-            status = exc.status_code
-            return Failure(retry=status == 429 or status >= 500, detail=_server_message(exc),
-                           status=status, wait=retry_after_seconds(exc.response.headers))
+            return Failure.http(exc.status_code, _server_message(exc),
+                                retry_after_seconds(exc.response.headers))
         if isinstance(exc, openai.OpenAIError):
             return Failure(retry=False, detail=f"{type(exc).__name__}: {exc}")
         return None
