@@ -5,7 +5,7 @@ few negatives. Here every goal runs with naive placement and no scene check (the
 where most episodes fail), the image critic judges every subtask from the rendered views, and the
 rollout continues whatever it says, so each subtask gives one (critic, oracle) pair. Subtasks whose
 skill could not plan are left out (no critic is asked about them in a run either). Episode k
-uses the seed of episode k in ``vcage_vs_vanilla``'s Vanilla datasets, so these are the same scenes.
+uses the seed of the first attempt at episode k in ``vcage_vs_vanilla``'s Vanilla run.
 
 Printed per goal and overall: judged subtasks, the oracle's failures among them, agreement,
 precision and recall of "accept" (as in ``vcage audit``), and the share of the oracle's failures the

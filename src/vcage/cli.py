@@ -83,8 +83,11 @@ def generate_cmd(
         seed: int = typer.Option(0), max_attempts: int = typer.Option(10, min=1),
         cameras: str = typer.Option("front,panda/wrist", help="comma-separated cameras to record"),
         size: int = typer.Option(128, help="video width and height (even)"),
-        workers: int = typer.Option(1, min=1, help="processes attempting episodes in parallel (one "
-                                    "core each); the dataset is the same for any number")) -> None:
+        workers: int = typer.Option(1, min=1, help="episodes attempted at once (one core each); the "
+                                    "dataset is the same for any number"),
+        executor: str = typer.Option("local", help="local (this machine: processes) or ray"),
+        address: str = typer.Option(None, help="with --executor ray: a running cluster's address "
+                                    "(e.g. auto); default: start Ray locally")) -> None:
     """Generate a verified dataset for INSTRUCTION; prints the funnel and writes stats.json."""
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
@@ -108,7 +111,8 @@ def generate_cmd(
                 bar.update(job, completed=f.accepted + f.given_up,
                            description=f"episodes (attempts {f.attempts}, accepted {f.accepted})")
 
-            funnel = generate(instruction, episodes, out, cfg, progress=update, workers=workers)
+            funnel = generate(instruction, episodes, out, cfg, progress=update, workers=workers,
+                              executor=executor, address=address)
     except VcageError as exc:
         _fail(exc)
         return

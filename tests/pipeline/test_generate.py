@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from vcage.data import DatasetReader
-from vcage.errors import ConfigError, DatasetError, PlanningError
+from vcage.errors import ConfigError, DatasetError, PlanningError, RegistryError
 from vcage.pipeline.audit import audit
 from vcage.pipeline.config import GenerateConfig
 from vcage.pipeline.generate import ATTEMPTS_LOG, STATS_FILE, generate
@@ -69,6 +69,27 @@ def test_workers_make_the_same_dataset(tmp_path: Path) -> None:
     assert stats["core_seconds"] == pytest.approx(2 * stats["wall_seconds"], rel=0.01)
     with pytest.raises(ConfigError, match="workers"):
         generate(SHORT, 1, tmp_path / "bad", cfg, workers=0)
+    with pytest.raises(ConfigError, match="executor ray"):
+        generate(SHORT, 1, tmp_path / "bad", cfg, address="auto")
+    with pytest.raises(RegistryError, match="valid names: local, ray"):
+        generate(SHORT, 1, tmp_path / "bad", cfg, executor="slurm")
+    assert not (tmp_path / "bad" / "meta").exists()
+
+
+def test_ray_executor_makes_the_same_dataset(tmp_path: Path) -> None:
+    ray = pytest.importorskip("ray")
+    cfg = GenerateConfig(**SMALL)
+    ray.init(num_cpus=2, include_dashboard=False, log_to_driver=False,
+             object_store_memory=128 * 1024 * 1024)
+    try:
+        remote = generate(SHORT, 2, tmp_path / "ray", cfg, workers=2, executor="ray")
+    finally:
+        ray.shutdown()
+    local = generate(SHORT, 2, tmp_path / "local", cfg)
+    assert (remote.accepted, remote.attempts) == (local.accepted, local.attempts) == (2, 2)
+    a, b = DatasetReader(tmp_path / "local"), DatasetReader(tmp_path / "ray")
+    for k in range(2):
+        np.testing.assert_array_equal(a.episode(k).arrays["states"], b.episode(k).arrays["states"])
 
 
 def test_append_needs_the_same_config_and_keeps_episodes(tmp_path: Path) -> None:

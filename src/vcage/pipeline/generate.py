@@ -1,50 +1,32 @@
-"""The generation driver: plan once, then attempt episodes until enough are accepted.
+"""The generation driver: plan once, sample episodes on an executor, write what is accepted.
 
-Each episode gets up to ``max_attempts`` attempts with derived seeds; an accepted attempt is
-rendered (videos are made by replaying the recorded simulator states, so rejected attempts cost no
-video rendering) and written to the dataset atomically. Every attempt, accepted or not, is logged
-with its oracle audit in ``meta/vcage_attempts.jsonl``; the funnel goes to ``stats.json``.
+Each episode gets up to ``max_attempts`` attempts with derived seeds (:mod:`.sampling`); an
+accepted one is written to the dataset atomically, in episode order. Every attempt, accepted or
+not, is logged with its oracle audit in ``meta/vcage_attempts.jsonl``; the funnel goes to
+``stats.json``.
 """
 
 from __future__ import annotations
 
-import itertools
 import json
-import multiprocessing
-import os
 import re
 import time
-from collections import Counter, deque
-from collections.abc import Callable, Iterator
-from concurrent.futures import ProcessPoolExecutor
+from collections import Counter
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
-from vcage.critics import ground_truth, image, vlm  # noqa: F401  (register the critics)
-from vcage.critics.base import CRITICS, Critic
-from vcage.data import DatasetWriter, Feature
-from vcage.errors import ConfigError
+from vcage.data import DatasetWriter
 from vcage.pipeline.config import GenerateConfig
-from vcage.pipeline.episode import Attempt, Timing, attempt
+from vcage.pipeline.episode import Timing
+from vcage.pipeline.executors import EXECUTORS
+from vcage.pipeline.sampling import FEATURES, EpisodeRun, camera_key, make_critic
 from vcage.planning import make_planner
 from vcage.planning.schema import Plan
-from vcage.sim.render import Renderer
 
 ATTEMPTS_LOG = "meta/vcage_attempts.jsonl"
 STATS_FILE = "stats.json"
-JOINTS = [f"joint{i}" for i in range(1, 8)]
-FEATURES = {
-    "observation.state": Feature("float32", (8,), names=[*JOINTS, "gripper_width"]),
-    "observation.ee_pose": Feature("float32", (7,), names=["x", "y", "z", "qw", "qx", "qy", "qz"]),
-    "action": Feature("float32", (8,), names=[*JOINTS, "gripper"]),
-}
-
-
-def camera_key(camera: str) -> str:
-    return "observation.images." + camera.split("/")[-1]
 
 
 @dataclass
@@ -89,40 +71,19 @@ class Funnel:
 Progress = Callable[[Funnel], None]
 
 
-@dataclass
-class EpisodeData:
-    """An accepted episode ready for the writer: per-frame features, videos, extras, arrays."""
-
-    frames: dict[str, np.ndarray]
-    videos: dict[str, np.ndarray]
-    extras: dict[str, Any]
-    arrays: dict[str, np.ndarray]
-
-
-@dataclass
-class EpisodeRun:
-    """What one episode's attempts produced: a log record and timing per attempt, and the episode
-    if one was accepted (with the time its videos took to render)."""
-
-    index: int
-    records: list[dict[str, Any]] = field(default_factory=list)
-    timings: list[Timing] = field(default_factory=list)
-    episode: EpisodeData | None = None
-    video_seconds: float = 0.0
-
-
 def generate(instruction: str, episodes: int, out: Path, cfg: GenerateConfig,
-             progress: Progress | None = None, plan: Plan | None = None, workers: int = 1) -> Funnel:
+             progress: Progress | None = None, plan: Plan | None = None, workers: int = 1,
+             executor: str = "local", address: str | None = None) -> Funnel:
     """Generate ``episodes`` accepted episodes into the dataset at ``out``; returns the funnel.
 
-    With ``workers > 1`` episodes are attempted in that many processes; each episode's attempts
-    depend only on its seeds, so the dataset is the same as with one worker.
+    ``executor`` (``local`` or ``ray``, see :mod:`vcage.pipeline.executors`) runs up to ``workers``
+    episodes at once (``address``: a Ray cluster's). Each episode's attempts depend only on its
+    seeds, so the dataset is the same for any executor and number of workers.
     """
-    if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
-        raise ConfigError(f"workers must be a positive integer, got {workers!r}")
+    pool = EXECUTORS.get(executor)(workers, address)  # checks the arguments before any work
     t0 = time.perf_counter()
     plan = plan or make_planner(cfg.planner).plan(instruction)
-    critic = _critic(cfg)  # built here too, so a misconfigured critic fails before any work
+    make_critic(cfg)  # a misconfigured critic (e.g. no API key) fails here, before any work
     width, height = cfg.size
     funnel = Funnel(episodes_requested=episodes, workers=workers)
     with DatasetWriter(out, fps=_fps(), features=FEATURES,
@@ -130,10 +91,7 @@ def generate(instruction: str, episodes: int, out: Path, cfg: GenerateConfig,
                        robot_type="franka_panda",
                        config={"generate": cfg.to_dict(), "plan": plan.model_dump(mode="json")}) as writer:
         first = writer.num_episodes
-        indices = range(first, first + episodes)
-        runs = (run_episode(plan, k, cfg, critic) for k in indices) if workers == 1 else \
-            _in_processes(plan, cfg, indices, workers)
-        for run in runs:
+        for run in pool.runs(plan, cfg, range(first, first + episodes)):
             _record(out, writer, plan, run, funnel)
             funnel.wall = time.perf_counter() - t0
             if progress is not None:
@@ -141,25 +99,6 @@ def generate(instruction: str, episodes: int, out: Path, cfg: GenerateConfig,
     funnel.wall = time.perf_counter() - t0
     (out / STATS_FILE).write_text(json.dumps(funnel.to_dict(), indent=2))
     return funnel
-
-
-def run_episode(plan: Plan, index: int, cfg: GenerateConfig, critic: Critic | None) -> EpisodeRun:
-    """Attempt episode ``index`` with its derived seeds until one attempt is accepted or the bound."""
-    run = EpisodeRun(index)
-    for j in range(cfg.max_attempts):
-        result = attempt(plan, cfg.episode_seed(index, j), cfg, critic)
-        run.records.append(_log_record(index, j, result))
-        run.timings.append(result.timing)
-        if result.accepted:
-            t0 = time.perf_counter()
-            run.episode = _episode_data(plan, cfg, result, j)
-            run.video_seconds = time.perf_counter() - t0
-            break
-    return run
-
-
-def _critic(cfg: GenerateConfig) -> Critic | None:
-    return CRITICS.get(cfg.critic_name)() if cfg.critic_name else None
 
 
 def _record(out: Path, writer: DatasetWriter, plan: Plan, run: EpisodeRun, funnel: Funnel) -> None:
@@ -175,37 +114,6 @@ def _record(out: Path, writer: DatasetWriter, plan: Plan, run: EpisodeRun, funne
         return
     ep = run.episode
     writer.add_episode(ep.frames, ep.videos, task=plan.instruction, extras=ep.extras, arrays=ep.arrays)
-
-
-# Worker processes: each builds its own critic once, then runs whole episodes.
-_WORKER: dict[str, Any] = {}
-
-
-def _start_worker(plan: Plan, cfg: GenerateConfig) -> None:
-    os.environ.setdefault("LP_NUM_THREADS", "1")  # one rasteriser thread: a worker is one core
-    _WORKER.update(plan=plan, cfg=cfg, critic=_critic(cfg))
-
-
-def _worker_episode(index: int) -> EpisodeRun:
-    return run_episode(_WORKER["plan"], index, _WORKER["cfg"], _WORKER["critic"])
-
-
-def _in_processes(plan: Plan, cfg: GenerateConfig, indices: range, workers: int) -> Iterator[EpisodeRun]:
-    """Episodes from ``workers`` processes, yielded in index order (a few run ahead)."""
-    context = multiprocessing.get_context("spawn")  # fresh processes: no GL context or thread is forked
-    with ProcessPoolExecutor(workers, mp_context=context, initializer=_start_worker,
-                             initargs=(plan, cfg)) as pool:
-        todo = iter(indices)
-        pending = deque(pool.submit(_worker_episode, k) for k in itertools.islice(todo, 2 * workers))
-        try:
-            while pending:
-                run = pending.popleft().result()
-                for k in itertools.islice(todo, 1):
-                    pending.append(pool.submit(_worker_episode, k))
-                yield run
-        finally:
-            for future in pending:
-                future.cancel()
 
 
 def _fps() -> int:
@@ -230,50 +138,3 @@ def _reason_key(reason: str) -> str:
     return re.sub(r"\d+(\.\d+)?", "N", reason.split(";")[0]).strip()[:90]
 
 
-def _audit(result: Attempt) -> list[dict[str, Any]]:
-    if result.rollout is None:
-        return []
-    return [{"subtask": o.index, "skill": o.skill, "description": o.description, "frames": [o.start, o.end],
-             "oracle": o.oracle, "oracle_success": o.oracle_success, "skill_error": o.skill_error}
-            for o in result.rollout.outcomes]
-
-
-def _log_record(episode: int, index: int, result: Attempt) -> dict[str, Any]:
-    return {"episode": episode, "attempt": index, "seed": result.seed, "stage": result.stage,
-            "reason": result.reason, "oracle_success": result.oracle_success,
-            "audit": _audit(result),
-            "verdicts": [o.verdict for o in result.rollout.outcomes] if result.rollout else []}
-
-
-def _episode_data(plan: Plan, cfg: GenerateConfig, result: Attempt, index: int) -> EpisodeData:
-    assert result.recording is not None and result.world is not None and result.rollout is not None
-    rec = result.recording.arrays()
-    frames = {
-        "observation.state": np.column_stack([rec["qpos"], rec["gripper"]]).astype(np.float32),
-        "observation.ee_pose": np.column_stack([rec["ee_pos"], rec["ee_quat"]]).astype(np.float32),
-        "action": rec["action"].astype(np.float32),
-    }
-    states = np.asarray(result.recording.states)
-    extras = {
-        "seed": result.seed, "attempt": index, "instruction": plan.instruction,
-        "plan": plan.model_dump(mode="json"),
-        "config": cfg.to_dict(), "scene": result.scene.to_dict() if result.scene else None,
-        "subtasks": [{"index": o.index, "description": o.description, "frames": [o.start, o.end],
-                      "verdict": o.verdict} for o in result.rollout.outcomes],
-        "oracle_audit": _audit(result), "oracle_success": result.oracle_success,
-    }
-    arrays = {"states": states, "initial_state": np.asarray(result.initial_state)}
-    return EpisodeData(frames, _render_videos(result, states, cfg), extras, arrays)
-
-
-def _render_videos(result: Attempt, states: np.ndarray, cfg: GenerateConfig) -> dict[str, np.ndarray]:
-    world = result.world
-    assert world is not None
-    width, height = cfg.size
-    out = {camera_key(c): np.empty((len(states), height, width, 3), np.uint8) for c in cfg.cameras}
-    with Renderer(world, width, height) as renderer:
-        for i, state in enumerate(states):
-            world.set_state(state)
-            for cam in cfg.cameras:
-                out[camera_key(cam)][i] = renderer.rgb(cam)
-    return out

@@ -1,0 +1,125 @@
+"""Rejection sampling of one episode: attempts with derived seeds until one is accepted.
+
+An accepted attempt is turned into what the dataset writer needs: per-frame features, videos made
+by replaying the recorded simulator states (so rejected attempts cost no video rendering), the
+extras that reproduce and audit it, and the simulator states. Every attempt also gives a log record
+with its oracle audit. Everything returned is plain data, so episodes can run in other processes.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from vcage.critics import ground_truth, image, vlm  # noqa: F401  (register the critics)
+from vcage.critics.base import CRITICS, Critic
+from vcage.data import Feature
+from vcage.pipeline.config import GenerateConfig
+from vcage.pipeline.episode import Attempt, Timing, attempt
+from vcage.planning.schema import Plan
+from vcage.sim.render import Renderer
+
+JOINTS = [f"joint{i}" for i in range(1, 8)]
+FEATURES = {
+    "observation.state": Feature("float32", (8,), names=[*JOINTS, "gripper_width"]),
+    "observation.ee_pose": Feature("float32", (7,), names=["x", "y", "z", "qw", "qx", "qy", "qz"]),
+    "action": Feature("float32", (8,), names=[*JOINTS, "gripper"]),
+}
+
+
+def camera_key(camera: str) -> str:
+    return "observation.images." + camera.split("/")[-1]
+
+
+@dataclass
+class EpisodeData:
+    """An accepted episode ready for the writer: per-frame features, videos, extras, arrays."""
+
+    frames: dict[str, np.ndarray]
+    videos: dict[str, np.ndarray]
+    extras: dict[str, Any]
+    arrays: dict[str, np.ndarray]
+
+
+@dataclass
+class EpisodeRun:
+    """What one episode's attempts produced: a log record and timing per attempt, and the episode
+    if one was accepted (with the time its videos took to render)."""
+
+    index: int
+    records: list[dict[str, Any]] = field(default_factory=list)
+    timings: list[Timing] = field(default_factory=list)
+    episode: EpisodeData | None = None
+    video_seconds: float = 0.0
+
+
+def run_episode(plan: Plan, index: int, cfg: GenerateConfig, critic: Critic | None) -> EpisodeRun:
+    """Attempt episode ``index`` with its derived seeds until one attempt is accepted or the bound."""
+    run = EpisodeRun(index)
+    for j in range(cfg.max_attempts):
+        result = attempt(plan, cfg.episode_seed(index, j), cfg, critic)
+        run.records.append(log_record(index, j, result))
+        run.timings.append(result.timing)
+        if result.accepted:
+            t0 = time.perf_counter()
+            run.episode = episode_data(plan, cfg, result, j)
+            run.video_seconds = time.perf_counter() - t0
+            break
+    return run
+
+
+def make_critic(cfg: GenerateConfig) -> Critic | None:
+    """The critic ``cfg`` names, or None (Vanilla)."""
+    return CRITICS.get(cfg.critic_name)() if cfg.critic_name else None
+
+
+def _audit(result: Attempt) -> list[dict[str, Any]]:
+    if result.rollout is None:
+        return []
+    return [{"subtask": o.index, "skill": o.skill, "description": o.description, "frames": [o.start, o.end],
+             "oracle": o.oracle, "oracle_success": o.oracle_success, "skill_error": o.skill_error}
+            for o in result.rollout.outcomes]
+
+
+def log_record(episode: int, index: int, result: Attempt) -> dict[str, Any]:
+    return {"episode": episode, "attempt": index, "seed": result.seed, "stage": result.stage,
+            "reason": result.reason, "oracle_success": result.oracle_success,
+            "audit": _audit(result),
+            "verdicts": [o.verdict for o in result.rollout.outcomes] if result.rollout else []}
+
+
+def episode_data(plan: Plan, cfg: GenerateConfig, result: Attempt, index: int) -> EpisodeData:
+    assert result.recording is not None and result.world is not None and result.rollout is not None
+    rec = result.recording.arrays()
+    frames = {
+        "observation.state": np.column_stack([rec["qpos"], rec["gripper"]]).astype(np.float32),
+        "observation.ee_pose": np.column_stack([rec["ee_pos"], rec["ee_quat"]]).astype(np.float32),
+        "action": rec["action"].astype(np.float32),
+    }
+    states = np.asarray(result.recording.states)
+    extras = {
+        "seed": result.seed, "attempt": index, "instruction": plan.instruction,
+        "plan": plan.model_dump(mode="json"),
+        "config": cfg.to_dict(), "scene": result.scene.to_dict() if result.scene else None,
+        "subtasks": [{"index": o.index, "description": o.description, "frames": [o.start, o.end],
+                      "verdict": o.verdict} for o in result.rollout.outcomes],
+        "oracle_audit": _audit(result), "oracle_success": result.oracle_success,
+    }
+    arrays = {"states": states, "initial_state": np.asarray(result.initial_state)}
+    return EpisodeData(frames, _render_videos(result, states, cfg), extras, arrays)
+
+
+def _render_videos(result: Attempt, states: np.ndarray, cfg: GenerateConfig) -> dict[str, np.ndarray]:
+    world = result.world
+    assert world is not None
+    width, height = cfg.size
+    out = {camera_key(c): np.empty((len(states), height, width, 3), np.uint8) for c in cfg.cameras}
+    with Renderer(world, width, height) as renderer:
+        for i, state in enumerate(states):
+            world.set_state(state)
+            for cam in cfg.cameras:
+                out[camera_key(cam)][i] = renderer.rgb(cam)
+    return out
