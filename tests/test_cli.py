@@ -43,6 +43,10 @@ def test_generate_inspect_audit_and_a_refused_append(tmp_path: Path) -> None:
     assert inspected.exit_code == 0 and "1 episodes" in text(inspected)
     audited = RUN.invoke(app, ["audit", str(out)])
     assert audited.exit_code == 0, audited.output
+    exported = RUN.invoke(app, ["export", str(out), str(tmp_path / "demos.hdf5")])
+    assert exported.exit_code == 0 and "1 demos" in text(exported), exported.output
+    again = RUN.invoke(app, ["export", str(out), str(tmp_path / "demos.hdf5")])
+    assert again.exit_code == 2 and "overwrite" in text(again)
     other = RUN.invoke(app, ["generate", "press the bell", "--episodes", "1", "--out", str(out),
                              "--clutter", "3", "--size", "64"])
     assert other.exit_code == 2 and "error:" in other.output

@@ -12,7 +12,7 @@ from rich.console import Console
 from rich.table import Table
 
 from vcage.config import Randomization
-from vcage.errors import VcageError
+from vcage.errors import ConfigError, VcageError
 
 if TYPE_CHECKING:
     from vcage.tasks.layout import SceneConfig
@@ -176,6 +176,26 @@ def audit_cmd(path: Path = typer.Argument(..., help="a dataset directory")) -> N
         _fail(exc)
         return
     console.print(report.summary())
+
+
+@app.command("export")
+def export_cmd(path: Path = typer.Argument(..., help="a dataset directory"),
+               out: Path = typer.Argument(..., help="the file to write, e.g. demos.hdf5"),
+               format: str = typer.Option("robomimic", help="robomimic (HDF5)"),
+               valid: float = typer.Option(0.1, help="share of episodes in mask/valid"),
+               overwrite: bool = typer.Option(False, help="replace OUT if it exists")) -> None:
+    """Export a dataset for policy learning: robomimic's HDF5 layout."""
+    if format != "robomimic":
+        _fail(ConfigError(f"unknown export format {format!r}; valid: robomimic"))
+    from vcage.data.robomimic import export_robomimic
+
+    try:
+        summary = export_robomimic(path, out, valid_fraction=valid, overwrite=overwrite)
+    except VcageError as exc:
+        _fail(exc)
+        return
+    console.print(f"wrote {summary.path}: {summary.demos} demos ({summary.train} train, {summary.valid} "
+                  f"valid), {summary.frames} frames; obs keys {', '.join(summary.obs_keys)}")
 
 
 @app.command("catalog")
