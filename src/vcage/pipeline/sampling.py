@@ -85,6 +85,7 @@ def _audit(result: Attempt) -> list[dict[str, Any]]:
 
 
 def log_record(episode: int, index: int, result: Attempt) -> dict[str, Any]:
+    """The attempt's line in ``meta/vcage_attempts.jsonl``: outcome, oracle audit, verdicts."""
     return {"episode": episode, "attempt": index, "seed": result.seed, "stage": result.stage,
             "reason": result.reason, "oracle_success": result.oracle_success,
             "audit": _audit(result),
@@ -92,6 +93,7 @@ def log_record(episode: int, index: int, result: Attempt) -> dict[str, Any]:
 
 
 def episode_data(plan: Plan, cfg: GenerateConfig, result: Attempt, index: int) -> EpisodeData:
+    """What the writer needs for accepted attempt ``index``: features, videos, extras, states."""
     assert result.recording is not None and result.world is not None and result.rollout is not None
     rec = result.recording.arrays()
     frames = {
