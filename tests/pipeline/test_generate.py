@@ -9,10 +9,13 @@ import numpy as np
 import pytest
 
 from vcage.data import DatasetReader
-from vcage.errors import ConfigError, DatasetError, PlanningError, RegistryError
+from vcage.errors import ConfigError, DatasetError, PlanningError, RegistryError, SceneError
 from vcage.pipeline.audit import audit
 from vcage.pipeline.config import GenerateConfig
 from vcage.pipeline.generate import ATTEMPTS_LOG, STATS_FILE, generate
+from vcage.scene.compose import compose
+from vcage.scene.spec import SceneSpec
+from vcage.tasks import predicates as P
 
 SHORT = "press the bell"
 SMALL = {"clutter": 2, "size": (64, 64)}
@@ -50,6 +53,21 @@ def test_same_seed_same_episode_and_replayable_states(tmp_path: Path) -> None:
     ea, eb = DatasetReader(a).episode(0), DatasetReader(b).episode(0)
     np.testing.assert_array_equal(ea.frames["action"], eb.frames["action"])
     assert ea.extras["seed"] == eb.extras["seed"] and ea.extras["scene"] == eb.extras["scene"]
+    # the dataset alone rebuilds the world and replays it: the oracle holds in the last state
+    scene = SceneSpec.from_dict(ea.extras["scene"])
+    assert json.loads(json.dumps(scene.to_dict())) == ea.extras["scene"]
+    world = compose(scene).make_world()
+
+    def pressed_at(frame: int) -> bool:
+        world.set_state(ea.arrays["states"][frame])
+        world.forward()
+        return P.pressed(world, "bell")
+
+    start, end = ea.extras["subtasks"][0]["frames"]
+    assert not pressed_at(start) and any(pressed_at(f) for f in range(start, end))
+    assert not pressed_at(end - 1) and P.upright(world, "bell")  # released again, still standing
+    with pytest.raises(SceneError, match="not a scene spec"):
+        SceneSpec.from_dict({"objects": [{"name": "x"}]})
 
 
 def test_workers_make_the_same_dataset(tmp_path: Path) -> None:

@@ -77,3 +77,23 @@ class SceneSpec:
 
     def to_dict(self) -> dict[str, Any]:
         return asdict(self)
+
+    @classmethod
+    def from_dict(cls, data: dict[str, Any]) -> SceneSpec:
+        """The scene :meth:`to_dict` wrote (e.g. in a dataset's extras); bad data raises SceneError."""
+        try:
+            table = dict(data.get("table") or {})
+            for key in ("size", "rgba"):
+                if key in table:
+                    table[key] = tuple(table[key])
+            objects = []
+            for obj in data.get("objects") or ():
+                obj = dict(obj)
+                obj["xy"] = tuple(obj["xy"])
+                objects.append(ObjectSpec(**obj))
+            rest = {k: v for k, v in data.items() if k not in ("objects", "table")}
+            if "camera_offset" in rest:
+                rest["camera_offset"] = tuple(rest["camera_offset"])
+            return cls(objects=tuple(objects), table=TableSpec(**table), **rest)
+        except (TypeError, KeyError, ValueError) as exc:
+            raise SceneError(f"not a scene spec: {exc}") from exc

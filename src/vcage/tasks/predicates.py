@@ -58,7 +58,21 @@ def inside(world: World, obj: str, container: str, placement: str | None = None)
 
 
 def on_table(world: World, obj: str, tol: float = 0.01) -> bool:
-    return abs(world.object_pos(obj)[2] - world.table_top()) <= tol
+    """``obj`` rests on the table: one of its geoms touches the table top (within ``tol``).
+
+    Contact, not the height of the object's origin: a cube lying on a side face is on the table
+    although its origin (the centre of its bottom face) is half a side higher, and an object on a
+    mat or on another object is not, however thin the thing under it.
+    """
+    d = world.data
+    if d.ncon == 0:
+        return False
+    top = world.model.geom("table/top").id
+    g1, g2 = d.contact.geom1[: d.ncon], d.contact.geom2[: d.ncon]
+    other = np.where(g1 == top, g2, np.where(g2 == top, g1, -1))
+    near = (other >= 0) & (d.contact.dist[: d.ncon] <= tol)
+    idx = world.object_names.index(obj)
+    return bool(np.any(world.object_of_geom(other[near]) == idx))
 
 
 def stacked(world: World, objs: list[str]) -> bool:
