@@ -16,8 +16,7 @@ import httpx2
 from google import genai
 from google.genai import errors, types
 
-from vcage.backends.base import BackendConfig, ChatBackend, Failure, Message
-from vcage.backends.openai_compat import retry_after_seconds
+from vcage.backends.base import BackendConfig, ChatBackend, Failure, Message, retry_after_seconds
 from vcage.errors import BackendError
 
 API_VERSION = "v1beta"

@@ -8,14 +8,12 @@ capped by ``max_backoff``; other 4xx fail at once.
 from __future__ import annotations
 
 import base64
-import email.utils
-import time
 from collections.abc import Sequence
 from typing import Any
 
 import openai
 
-from vcage.backends.base import BACKENDS, BackendConfig, ChatBackend, Failure, Message
+from vcage.backends.base import BACKENDS, BackendConfig, ChatBackend, Failure, Message, retry_after_seconds
 from vcage.errors import BackendError
 
 
@@ -28,28 +26,6 @@ def message_payload(message: Message) -> dict[str, Any]:
         url = "data:image/png;base64," + base64.b64encode(png).decode("ascii")
         parts.append({"type": "image_url", "image_url": {"url": url}})
     return {"role": message.role, "content": parts}
-
-
-def retry_after_seconds(headers: Any) -> float | None:
-    """Seconds a server asked to wait (``retry-after-ms`` or ``Retry-After``), or None."""
-    try:
-        millis = headers.get("retry-after-ms")
-        if millis is not None:
-            return max(0.0, float(millis) / 1000.0)
-        value = headers.get("retry-after")
-    except (AttributeError, ValueError):
-        return None
-    if value is None:
-        return None
-    try:
-        return max(0.0, float(value))
-    except ValueError:
-        pass
-    try:
-        when = email.utils.parsedate_to_datetime(value)
-    except (TypeError, ValueError):
-        return None
-    return max(0.0, when.timestamp() - time.time())
 
 
 def _server_message(exc: openai.APIStatusError) -> str:

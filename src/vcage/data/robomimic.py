@@ -24,8 +24,6 @@ import numpy as np
 from vcage.data.reader import DatasetReader
 from vcage.errors import DatasetError
 
-STANDARD_COLUMNS = {"timestamp", "frame_index", "episode_index", "index", "task_index"}
-
 
 @dataclass(frozen=True)
 class ExportSummary:
