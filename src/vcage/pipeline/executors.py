@@ -18,6 +18,7 @@ from collections.abc import Callable, Iterator
 from concurrent.futures import Future, ProcessPoolExecutor
 from typing import Any, TypeVar
 
+from vcage.critics.base import Critic
 from vcage.errors import ConfigError
 from vcage.pipeline.config import GenerateConfig
 from vcage.pipeline.sampling import EpisodeRun, make_critic, run_episode
@@ -37,8 +38,13 @@ class EpisodeExecutor(ABC):
         self.workers, self.address = workers, address
 
     @abstractmethod
-    def runs(self, plan: Plan, cfg: GenerateConfig, indices: range) -> Iterator[EpisodeRun]:
-        """The episodes ``indices`` of ``plan``, in index order."""
+    def runs(self, plan: Plan, cfg: GenerateConfig, indices: range,
+             critic: Critic | None) -> Iterator[EpisodeRun]:
+        """The episodes ``indices`` of ``plan``, in index order.
+
+        ``critic`` judges episodes run in this process; worker processes build their own from
+        ``cfg`` (a critic may hold connections that do not cross processes).
+        """
 
 
 EXECUTORS: Registry[type[EpisodeExecutor]] = Registry("executor")
@@ -53,9 +59,9 @@ class LocalExecutor(EpisodeExecutor):
         if address is not None:
             raise ConfigError("the local executor runs on this machine; an address needs --executor ray")
 
-    def runs(self, plan: Plan, cfg: GenerateConfig, indices: range) -> Iterator[EpisodeRun]:
+    def runs(self, plan: Plan, cfg: GenerateConfig, indices: range,
+             critic: Critic | None) -> Iterator[EpisodeRun]:
         if self.workers == 1:
-            critic = make_critic(cfg)
             for k in indices:
                 yield run_episode(plan, k, cfg, critic)
             return
@@ -82,7 +88,8 @@ class RayExecutor(EpisodeExecutor):
             raise ConfigError("the ray executor needs Ray: pip install 'vcage[ray]'") from exc
         self.ray = ray
 
-    def runs(self, plan: Plan, cfg: GenerateConfig, indices: range) -> Iterator[EpisodeRun]:
+    def runs(self, plan: Plan, cfg: GenerateConfig, indices: range,
+             critic: Critic | None) -> Iterator[EpisodeRun]:
         ray = self.ray
         started = not ray.is_initialized()
         if started:

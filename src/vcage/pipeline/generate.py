@@ -83,7 +83,7 @@ def generate(instruction: str, episodes: int, out: Path, cfg: GenerateConfig,
     pool = EXECUTORS.get(executor)(workers, address)  # checks the arguments before any work
     t0 = time.perf_counter()
     plan = plan or make_planner(cfg.planner).plan(instruction)
-    make_critic(cfg)  # a misconfigured critic (e.g. no API key) fails here, before any work
+    critic = make_critic(cfg)  # a misconfigured critic (e.g. no API key) fails here, before any work
     width, height = cfg.size
     funnel = Funnel(episodes_requested=episodes, workers=workers)
     with DatasetWriter(out, fps=_fps(), features=FEATURES,
@@ -91,7 +91,7 @@ def generate(instruction: str, episodes: int, out: Path, cfg: GenerateConfig,
                        robot_type="franka_panda",
                        config={"generate": cfg.to_dict(), "plan": plan.model_dump(mode="json")}) as writer:
         first = writer.num_episodes
-        for run in pool.runs(plan, cfg, range(first, first + episodes)):
+        for run in pool.runs(plan, cfg, range(first, first + episodes), critic):
             _record(out, writer, plan, run, funnel)
             funnel.wall = time.perf_counter() - t0
             if progress is not None:
