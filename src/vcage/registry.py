@@ -1,4 +1,10 @@
-"""One registry mechanism for tasks, skills, planners, critics, backends and writers."""
+"""One registry mechanism for tasks, skills, predicates, planners, critics, backends, placers,
+executors and the object catalog.
+
+A registry maps names to items. Items are added when the module defining them is imported, and
+every package imports its built-in modules from its ``__init__``, so importing a package fills its
+registry. Adding a name twice raises; an unknown name lists the valid ones.
+"""
 
 from __future__ import annotations
 
@@ -11,15 +17,20 @@ T = TypeVar("T")
 
 
 class Registry(Generic[T]):
-    """A named mapping; duplicates raise and unknown names list the valid ones."""
+    """A named mapping; duplicates raise and unknown names list the valid ones.
 
-    def __init__(self, kind: str) -> None:
+    ``error`` is the exception raised for both (a subclass of :class:`RegistryError` or of another
+    ``VcageError`` taking one message), so a domain can keep its own error type.
+    """
+
+    def __init__(self, kind: str, error: type[Exception] = RegistryError) -> None:
         self.kind = kind
+        self.error = error
         self._items: dict[str, T] = {}
 
     def add(self, name: str, item: T) -> T:
         if name in self._items:
-            raise RegistryError(f"{self.kind} {name!r} is already registered; choose another name")
+            raise self.error(f"{self.kind} {name!r} is already registered; choose another name")
         self._items[name] = item
         return item
 
@@ -34,12 +45,16 @@ class Registry(Generic[T]):
     def get(self, name: str) -> T:
         try:
             return self._items[name]
-        except KeyError:
+        except (KeyError, TypeError):
             valid = ", ".join(sorted(self._items)) or "(none registered)"
-            raise RegistryError(f"unknown {self.kind} {name!r}; valid names: {valid}") from None
+            raise self.error(f"unknown {self.kind} {name!r}; valid names: {valid}") from None
 
     def names(self) -> list[str]:
         return sorted(self._items)
+
+    def values(self) -> list[T]:
+        """The items, in name order."""
+        return [self._items[n] for n in self.names()]
 
     def __contains__(self, name: object) -> bool:
         return name in self._items
