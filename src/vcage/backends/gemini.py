@@ -16,7 +16,10 @@ import httpx2
 from google import genai
 from google.genai import errors, types
 
-from vcage.backends.base import BackendConfig, ChatBackend, Failure, Message, retry_after_seconds
+from vcage.backends.base import ChatBackend
+from vcage.backends.config import BackendConfig
+from vcage.backends.messages import Message
+from vcage.backends.retry import Failure, retry_after_seconds
 from vcage.errors import BackendError
 
 API_VERSION = "v1beta"
@@ -50,7 +53,8 @@ def retry_delay_seconds(details: Any) -> float | None:
 class GeminiChatBackend(ChatBackend):
     """``models.generate_content`` through ``google-genai`` against ``config.base_url``.
 
-Registered as ``gemini`` in ``vcage.backends``, which imports this module only when it is used.
+Registered as ``gemini`` in :mod:`vcage.backends.builtin`, whose factory imports this module only when
+it is used.
 """
 
     name = "gemini"

@@ -13,7 +13,10 @@ from typing import Any
 
 import openai
 
-from vcage.backends.base import BACKENDS, BackendConfig, ChatBackend, Failure, Message, retry_after_seconds
+from vcage.backends.base import ChatBackend
+from vcage.backends.config import BackendConfig
+from vcage.backends.messages import Message
+from vcage.backends.retry import Failure, retry_after_seconds
 from vcage.errors import BackendError
 
 
@@ -37,9 +40,9 @@ def _server_message(exc: openai.APIStatusError) -> str:
     return exc.message
 
 
-@BACKENDS.register("openai")
 class OpenAIChatBackend(ChatBackend):
-    """Chat completions through the ``openai`` SDK against ``config.base_url``."""
+    """Chat completions through the ``openai`` SDK against ``config.base_url``; registered as ``openai``
+    (the class is its own factory) in :mod:`vcage.backends.builtin`."""
 
     name = "openai"
     not_found_hint = "check base_url (OpenAI-compatible servers usually end in /v1) and the model name"
