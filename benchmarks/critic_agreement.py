@@ -23,8 +23,7 @@ from concurrent.futures import ProcessPoolExecutor
 
 os.environ.setdefault("LP_NUM_THREADS", "1")  # one rasteriser thread: a worker is one core
 
-from vcage.critics import image  # noqa: E402, F401  (registers the image critic)
-from vcage.critics.base import CRITICS, Critic, Observation, Verdict  # noqa: E402
+from vcage.critics import Critic, CriticConfig, Observation, Verdict, make_critic  # noqa: E402
 from vcage.pipeline.config import GenerateConfig  # noqa: E402
 from vcage.pipeline.episode import attempt  # noqa: E402
 from vcage.planning import make_planner  # noqa: E402
@@ -50,8 +49,8 @@ def _run(job: tuple[str, int]) -> list[tuple[str, bool, bool]]:
     goal, episode = job
     phrase = next(g for g in GOALS if g.name == goal).phrasings[0]
     plan = make_planner("offline").plan(phrase)
-    cfg = GenerateConfig(mode="vanilla", seed=0)  # episode k: the seed of the Vanilla run's episode k
-    shadow = Shadow(CRITICS.get("image")())
+    cfg = GenerateConfig.vanilla(seed=0)  # episode k: the seed of the Vanilla run's episode k
+    shadow = Shadow(make_critic(CriticConfig("image")))
     result = attempt(plan, cfg.episode_seed(episode, 0), cfg, shadow)
     if result.rollout is None:
         return []

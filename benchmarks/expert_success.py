@@ -15,9 +15,9 @@ from concurrent.futures import ProcessPoolExecutor
 
 from vcage.config import Randomization
 from vcage.errors import PlacementError, SimulationError, UnstableSceneError
+from vcage.scene.instantiate import SceneConfig
 from vcage.scene.placement import PLACERS
-from vcage.tasks.base import TASKS, SceneConfig
-from vcage.tasks.runner import make_task, run_episode
+from vcage.tasks import TASKS, run_episode
 
 
 def _one(args: tuple[str, int, bool, SceneConfig]) -> tuple[str, bool, int, bool, str]:
@@ -45,7 +45,6 @@ def main() -> None:
     parser.add_argument("--clutter", type=int, default=0)
     args = parser.parse_args()
     scene = SceneConfig(args.placement, args.clutter)
-    make_task("stack_blocks_two")
     tasks = args.tasks or TASKS.names()
     jobs = [(t, s, r, scene) for t in tasks for r in (False, True) for s in range(args.seeds)]
     t0 = time.perf_counter()

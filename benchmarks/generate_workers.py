@@ -13,6 +13,7 @@ import argparse
 import os
 import shutil
 import tempfile
+from dataclasses import replace
 from pathlib import Path
 
 os.environ.setdefault("LP_NUM_THREADS", "1")  # one rasteriser thread: a worker is one core
@@ -20,7 +21,7 @@ os.environ.setdefault("LP_NUM_THREADS", "1")  # one rasteriser thread: a worker 
 import numpy as np  # noqa: E402
 
 from vcage.data import DatasetReader  # noqa: E402
-from vcage.pipeline.config import GenerateConfig  # noqa: E402
+from vcage.pipeline.config import ExecutorConfig, GenerateConfig  # noqa: E402
 from vcage.pipeline.generate import generate  # noqa: E402
 
 
@@ -36,7 +37,8 @@ def main() -> None:
     try:
         rows = []
         for n in [1, *args.workers]:
-            funnel = generate(args.instruction, args.episodes, root / f"w{n}", cfg, workers=n)
+            funnel = generate(args.instruction, args.episodes, root / f"w{n}",
+                              replace(cfg, executor=ExecutorConfig(workers=n)))
             rows.append((n, funnel.to_dict()))
         base = DatasetReader(root / "w1")
         same = all(

@@ -25,7 +25,7 @@ from vcage.scene.compose import compose
 from vcage.scene.layout import Distractors, LayoutSpec
 from vcage.scene.placement import PLACERS, place
 from vcage.scene.stability import StabilityReport, check_stability
-from vcage.skills.reach import reach_map
+from vcage.skills.reachability import reach_map
 
 METHODS = ("context", "rejection", "naive")
 TILE = (480, 360)

@@ -16,7 +16,7 @@ import time
 
 from vcage.config import Randomization
 from vcage.sim.render import Renderer
-from vcage.tasks.runner import prepare
+from vcage.tasks import prepare
 
 CAMERAS = ("front", "overview", "top", "panda/wrist")
 SIZES = ((128, 128), (320, 240))

@@ -4,7 +4,7 @@
 
 Three loops advance the same scene by the same number of physics steps with the same controls:
 raw ``mujoco.mj_step`` called once per physics step from Python (the baseline), ``World.step``
-(one control period with the instability check), and the executor's tick (World.step plus
+(one control period with the instability check), and the player's tick (World.step plus
 recording joints, gripper, TCP pose and action). Ratios are time relative to the baseline.
 """
 
@@ -17,8 +17,8 @@ import numpy as np
 
 from vcage.config import Randomization
 from vcage.sim.robot import HOME_QPOS
-from vcage.skills.executor import Executor
-from vcage.tasks.runner import prepare
+from vcage.skills.playback import Player
+from vcage.tasks import prepare
 
 CONTROL_STEPS = 2000
 
@@ -50,22 +50,22 @@ def main() -> None:
         for _ in range(CONTROL_STEPS):
             world.step(ctrl)
 
-    executor = Executor(world)
+    player = Player(world)
 
-    def executor_tick() -> None:
+    def player_tick() -> None:
         world.set_state(start)
-        executor.recording.__init__()  # type: ignore[misc]
+        player.recording.__init__()  # type: ignore[misc]
         for _ in range(CONTROL_STEPS):
-            executor._tick(HOME_QPOS, 1.0)
+            player._tick(HOME_QPOS, 1.0)
 
-    t_raw, t_pipe, t_exec = _best_of(raw), _best_of(pipeline), _best_of(executor_tick)
+    t_raw, t_pipe, t_exec = _best_of(raw), _best_of(pipeline), _best_of(player_tick)
     phys = CONTROL_STEPS * n_sub
     print(f"scene: stack_blocks_three (nq={model.nq}, nbody={model.nbody}), timestep "
           f"{model.opt.timestep * 1000:.0f} ms, {n_sub} physics steps per control step, "
           f"{CONTROL_STEPS} control steps, best of 5\n")
     print(f"{'loop':34s} {'physics steps/s':>16s} {'ratio to raw':>13s}")
     for name, t in (("raw mj_step (baseline)", t_raw), ("World.step (pipeline)", t_pipe),
-                    ("Executor tick (with recording)", t_exec)):
+                    ("Player tick (with recording)", t_exec)):
         print(f"{name:34s} {phys / t:16,.0f} {t / t_raw:13.3f}")
     np.testing.assert_allclose(world.robot.arm_q(data), HOME_QPOS, atol=0.05)
 

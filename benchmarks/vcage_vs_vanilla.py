@@ -42,7 +42,8 @@ def _run(job: tuple[str, str, int, int, str]) -> dict:
     out = Path(root) / f"{goal}-{mode}"
     shutil.rmtree(out, ignore_errors=True)
     t0 = time.perf_counter()
-    funnel = generate(phrase, episodes, out, GenerateConfig(mode=mode, seed=seed))
+    cfg = GenerateConfig(seed=seed) if mode == "vcage" else GenerateConfig.vanilla(seed=seed)
+    funnel = generate(phrase, episodes, out, cfg)
     wall = time.perf_counter() - t0
     report = audit(out)
     stats = funnel.to_dict()

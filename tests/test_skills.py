@@ -36,15 +36,15 @@ def test_pick_and_place_stacks_and_records(world: World) -> None:
     skills = Skills(world)
     plan = SKILLS.get("pick_and_place")(skills, obj="a", target="b")
     assert plan.duration > 1.0 and all(w.q.shape == (7,) for w in plan.waypoints)
-    skills.executor.run(plan)
+    skills.player.run(plan)
     skills.do("retreat")
     world.settle(0.3)
     assert P.stacked(world, ["b", "a"]) and not P.grasped(world, "a")
-    rec = skills.executor.recording.arrays()
-    n = len(skills.executor.recording)
+    rec = skills.player.recording.arrays()
+    n = len(skills.player.recording)
     assert rec["qpos"].shape == (n, 7) and rec["action"].shape == (n, 8)
     assert rec["ee_pos"].shape == (n, 3) and rec["ee_quat"].shape == (n, 4)
-    assert [s[0] for s in skills.executor.recording.skills] == ["pick_and_place", "retreat"]
+    assert [s[0] for s in skills.player.recording.skills] == ["pick_and_place", "retreat"]
 
 
 def test_grasp_lift_rotate_push_press_primitives(world: World) -> None:

@@ -4,9 +4,42 @@ from __future__ import annotations
 
 import math
 from dataclasses import asdict, dataclass, field, fields, replace
-from typing import Any
+from typing import Any, TypeVar
 
 from vcage.errors import ConfigError
+
+C = TypeVar("C")
+
+# What the renderer can do: every composed scene has these cameras and this offscreen buffer
+# (width, height); `vcage.scene.compose` builds them and a test holds it to these names.
+CAMERAS = ("front", "overview", "top", "panda/wrist")
+OFFSCREEN_SIZE = (640, 480)
+
+
+def from_fields(cls: type[C], data: Any, **nested: Any) -> C:
+    """Build the dataclass ``cls`` from a dict as ``to_dict``/``asdict`` wrote it.
+
+    Unknown keys are refused with the valid ones; lists become tuples; keys named in ``nested``
+    are built with that class's ``from_dict`` (or recursively with this function).
+    """
+    if not isinstance(data, dict):
+        raise ConfigError(f"{cls.__name__} needs a mapping of its fields, got {type(data).__name__}")
+    known = [f.name for f in fields(cls)]  # type: ignore[arg-type]
+    unknown = sorted(set(data) - set(known))
+    if unknown:
+        raise ConfigError(f"unknown {cls.__name__} keys {unknown}; valid keys: {known}")
+    kwargs: dict[str, Any] = {}
+    for key, value in data.items():
+        if key in nested and isinstance(value, dict):
+            sub = nested[key]
+            value = sub.from_dict(value) if hasattr(sub, "from_dict") else from_fields(sub, value)
+        elif isinstance(value, list):
+            value = tuple(tuple(v) if isinstance(v, list) else v for v in value)
+        kwargs[key] = value
+    try:
+        return cls(**kwargs)
+    except TypeError as exc:
+        raise ConfigError(f"{cls.__name__}: {exc}") from None
 
 
 @dataclass(frozen=True)
@@ -113,3 +146,49 @@ class SimConfig:
     @property
     def substeps(self) -> int:
         return round(1.0 / (self.control_hz * self.timestep))
+
+
+    def to_dict(self) -> dict[str, Any]:
+        return asdict(self)
+
+    @classmethod
+    def from_dict(cls, data: dict[str, Any]) -> SimConfig:
+        return from_fields(cls, data)
+
+
+@dataclass(frozen=True)
+class RenderConfig:
+    """What is rendered: the cameras recorded as videos and their size, and the critic's views.
+
+    Sizes are (width, height) and are checked against the renderer's offscreen buffer; video sizes
+    must be even (H.264 4:2:0).
+    """
+
+    cameras: tuple[str, ...] = ("front", "panda/wrist")
+    size: tuple[int, int] = (128, 128)
+    critic_size: tuple[int, int] = (320, 240)
+
+    def __post_init__(self) -> None:
+        if not self.cameras:
+            raise ConfigError("record at least one camera")
+        unknown = [c for c in self.cameras if c not in CAMERAS]
+        if unknown:
+            raise ConfigError(f"unknown camera(s) {unknown}; cameras: {', '.join(CAMERAS)}")
+        if len(set(self.cameras)) != len(self.cameras):
+            raise ConfigError(f"cameras {list(self.cameras)} name one camera twice")
+        for what, (w, h) in (("video size", self.size), ("critic view size", self.critic_size)):
+            if not all(isinstance(v, int) and not isinstance(v, bool) for v in (w, h)):
+                raise ConfigError(f"{what} {w}x{h} must be whole pixels")
+            if not (0 < w <= OFFSCREEN_SIZE[0] and 0 < h <= OFFSCREEN_SIZE[1]):
+                raise ConfigError(f"{what} {w}x{h} must be positive and at most the renderer's "
+                                  f"{OFFSCREEN_SIZE[0]}x{OFFSCREEN_SIZE[1]}")
+        if any(v % 2 for v in self.size):
+            raise ConfigError(f"video size {self.size[0]}x{self.size[1]} must be even")
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"cameras": list(self.cameras), "size": list(self.size),
+                "critic_size": list(self.critic_size)}
+
+    @classmethod
+    def from_dict(cls, data: dict[str, Any]) -> RenderConfig:
+        return from_fields(cls, data)

@@ -7,12 +7,14 @@ import pytest
 
 from vcage.critics.base import Observation, View
 from vcage.critics.image import ImageCritic
-from vcage.critics.oracle import Oracle
+from vcage.pipeline.verifier import render_views
 from vcage.planning.goals import put_at, put_on
+from vcage.planning.schema import Predicate, Subtask
 from vcage.scene.compose import compose
 from vcage.scene.spec import ObjectSpec, SceneSpec
 from vcage.sim.render import Renderer
 from vcage.sim.world import World
+from vcage.tasks.oracle import Oracle
 
 CRITIC = ImageCritic()
 PAD = ObjectSpec("pad", "mouse_pad", (0.58, 0.1))
@@ -20,8 +22,7 @@ PAD = ObjectSpec("pad", "mouse_pad", (0.58, 0.1))
 
 def _views(world: World) -> dict[str, View]:
     with Renderer(world, 320, 240) as r:
-        return {cam: View(r.rgb(cam), r.segmentation(cam), r.depth(cam) if cam == "front" else None)
-                for cam in ("top", "front")}
+        return render_views(r)
 
 
 def _world(*objects: ObjectSpec) -> World:
@@ -33,7 +34,7 @@ def _world(*objects: ObjectSpec) -> World:
 def _judge(before: World, after: World, subtask):  # type: ignore[no-untyped-def]
     obs = Observation(subtask=subtask, labels=tuple(after.object_names), before=_views(before),
                       after=_views(after))
-    return CRITIC.judge(obs), Oracle().check(after, subtask)
+    return CRITIC.judge(obs), Oracle().check(after, subtask.predicates)
 
 
 def test_object_on_its_target_is_accepted_like_the_oracle() -> None:
@@ -71,3 +72,27 @@ def test_missing_views_reject_instead_of_guessing(missing: str) -> None:
                       before=views, after=views)
     assert not CRITIC.judge(obs).accept
     assert np.all(views[next(iter(views))].segmentation >= -2)
+
+
+def _subtask(*preds: tuple[str, tuple[str, ...]]) -> Subtask:
+    return Subtask(skill="retreat", description="a check of one predicate",
+                   predicates=tuple(Predicate(name=n, args=a) for n, a in preds))
+
+
+def test_near_is_measured_in_metres_from_the_orthographic_top_view() -> None:
+    close = _world(ObjectSpec("a", "block", (0.55, 0.0)), ObjectSpec("b", "block", (0.55, 0.07)))
+    verdict, oracle = _judge(close, close, _subtask(("near", ("a", "b"))))
+    assert verdict.accept and oracle["near(a, b)"], verdict.reason
+    far = _world(ObjectSpec("a", "block", (0.55, 0.0)), ObjectSpec("b", "block", (0.55, 0.2)))
+    verdict, oracle = _judge(far, far, _subtask(("near", ("a", "b"))))
+    assert not verdict.accept and not oracle["near(a, b)"] and "20 cm apart" in verdict.reason
+
+
+def test_lifted_needs_the_object_to_rise_in_the_front_view() -> None:
+    resting = _world(ObjectSpec("block", "block", (0.55, 0.0)))
+    held_up = compose(SceneSpec(objects=(ObjectSpec("block", "block", (0.55, 0.0), z=0.85),))).make_world()
+    held_up.forward()  # not settled: the block hangs where a hand would hold it
+    verdict, oracle = _judge(resting, held_up, _subtask(("lifted", ("block",))))
+    assert verdict.accept and oracle["lifted(block)"], verdict.reason
+    verdict, oracle = _judge(resting, resting, _subtask(("lifted", ("block",))))
+    assert not verdict.accept and not oracle["lifted(block)"] and "rose by 0 px" in verdict.reason

@@ -10,8 +10,8 @@ import pytest
 
 from backends.fake_openai import Delay, FakeOpenAI, Status
 from vcage.backends import BackendConfig, make_backend
-from vcage.critics.base import Observation, View
-from vcage.critics.vlm import VLMCritic, VLMCriticConfig, parse_answer
+from vcage.critics.base import CriticConfig, Observation, View
+from vcage.critics.vlm import VLMCritic, parse_answer
 from vcage.errors import ConfigError
 from vcage.planning.goals import put_on
 
@@ -36,7 +36,7 @@ def server() -> Iterator[FakeOpenAI]:
 def _critic(server: FakeOpenAI, timeout: float = 5.0, retries: int = 0, **cfg: object) -> VLMCritic:
     backend = make_backend("openai", BackendConfig(base_url=server.base_url, model="fake-vlm",
                                                    timeout=timeout, max_retries=retries, backoff=0.01))
-    return VLMCritic(backend, VLMCriticConfig(**cfg))  # type: ignore[arg-type]
+    return VLMCritic(backend, CriticConfig("vlm", **cfg))  # type: ignore[arg-type]
 
 
 def test_yes_accepts_and_sends_three_images(server: FakeOpenAI) -> None:
@@ -83,6 +83,6 @@ def test_answer_parsing_and_config_checks() -> None:
     assert parse_answer('{"answer": "yes", "reason": "ok"}') == {"success": True, "reason": "ok"}
     assert parse_answer("[true]") is None
     with pytest.raises(ConfigError):
-        VLMCriticConfig(votes=0)
+        CriticConfig("vlm", votes=0)
     with pytest.raises(ConfigError):
-        VLMCriticConfig(rule="some")
+        CriticConfig("vlm", rule="some")

@@ -8,17 +8,20 @@ import h5py
 import numpy as np
 import pytest
 
+from vcage.config import RenderConfig
 from vcage.data import DatasetReader
 from vcage.data.robomimic import export_robomimic, obs_key
 from vcage.errors import DatasetError
 from vcage.pipeline.config import GenerateConfig
 from vcage.pipeline.generate import generate
+from vcage.scene.instantiate import SceneConfig
 
 
 @pytest.fixture(scope="module")
 def dataset(tmp_path_factory: pytest.TempPathFactory) -> Path:
     out = tmp_path_factory.mktemp("robomimic") / "ds"
-    generate("press the bell", 2, out, GenerateConfig(clutter=1, size=(64, 64)))
+    cfg = GenerateConfig(scene=SceneConfig(clutter=1), render=RenderConfig(size=(64, 64)))
+    generate("press the bell", 2, out, cfg)
     return out
 
 

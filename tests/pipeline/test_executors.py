@@ -5,7 +5,8 @@ from __future__ import annotations
 import pytest
 
 from vcage.errors import ConfigError, RegistryError
-from vcage.pipeline.executors import AHEAD, EXECUTORS, LocalExecutor, _in_order
+from vcage.pipeline.config import ExecutorConfig
+from vcage.pipeline.executors import AHEAD, EXECUTORS, LocalExecutor, _in_order, make_executor
 from vcage.pipeline.sampling import EpisodeRun
 
 
@@ -45,8 +46,8 @@ def test_stopping_early_cancels_the_pending_episodes() -> None:
 def test_executor_arguments_are_checked_when_built() -> None:
     assert EXECUTORS.names() == ["local", "ray"]
     with pytest.raises(ConfigError, match="workers"):
-        LocalExecutor(0)
+        ExecutorConfig(workers=0)
     with pytest.raises(ConfigError, match="--executor ray"):
-        LocalExecutor(2, address="auto")
+        LocalExecutor(ExecutorConfig(workers=2, address="auto"))
     with pytest.raises(RegistryError, match="valid names: local, ray"):
-        EXECUTORS.get("slurm")
+        make_executor(ExecutorConfig("slurm"))

@@ -3,22 +3,26 @@
 from __future__ import annotations
 
 import json
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 import pytest
 
+from vcage.config import RenderConfig
 from vcage.data import DatasetReader
+from vcage.data.layout import ATTEMPTS_LOG, FUNNEL_PATH, VCAGE_PATH
 from vcage.errors import ConfigError, DatasetError, PlanningError, RegistryError, SceneError
 from vcage.pipeline.audit import audit
-from vcage.pipeline.config import GenerateConfig
-from vcage.pipeline.generate import ATTEMPTS_LOG, STATS_FILE, generate
+from vcage.pipeline.config import ExecutorConfig, GenerateConfig
+from vcage.pipeline.generate import generate
 from vcage.scene.compose import compose
+from vcage.scene.instantiate import SceneConfig
 from vcage.scene.spec import SceneSpec
 from vcage.tasks import predicates as P
 
 SHORT = "press the bell"
-SMALL = {"clutter": 2, "size": (64, 64)}
+SMALL = {"scene": SceneConfig(clutter=2), "render": RenderConfig(size=(64, 64))}
 
 
 def test_generate_writes_a_verified_dataset(tmp_path: Path) -> None:
@@ -36,7 +40,7 @@ def test_generate_writes_a_verified_dataset(tmp_path: Path) -> None:
     assert bounds[0][0] == 0 and bounds[0][1] <= bounds[1][0] and bounds[1][1] <= ep.length
     assert ep.arrays["states"].shape[0] == ep.length
     assert reader.video(0, "observation.images.front").shape == (ep.length, 64, 64, 3)
-    stats = json.loads((out / STATS_FILE).read_text())
+    stats = json.loads((out / FUNNEL_PATH).read_text())
     assert stats["accepted"] == 1 and stats["stages"]["accepted"] == 1
     seconds = stats["seconds"]
     assert seconds["physics"] > 0 and seconds["render"] > 0
@@ -73,7 +77,7 @@ def test_same_seed_same_episode_and_replayable_states(tmp_path: Path) -> None:
 def test_workers_make_the_same_dataset(tmp_path: Path) -> None:
     cfg = GenerateConfig(**SMALL)
     one = generate(SHORT, 2, tmp_path / "one", cfg)
-    two = generate(SHORT, 2, tmp_path / "two", cfg, workers=2)
+    two = generate(SHORT, 2, tmp_path / "two", replace(cfg, executor=ExecutorConfig(workers=2)))
     assert (one.accepted, one.attempts) == (two.accepted, two.attempts) and two.workers == 2
     a, b = DatasetReader(tmp_path / "one"), DatasetReader(tmp_path / "two")
     for k in range(2):
@@ -83,14 +87,17 @@ def test_workers_make_the_same_dataset(tmp_path: Path) -> None:
                                       b.video(k, "observation.images.front"))
     logs = [(tmp_path / d / ATTEMPTS_LOG).read_text().splitlines() for d in ("one", "two")]
     assert [json.loads(r)["seed"] for r in logs[0]] == [json.loads(r)["seed"] for r in logs[1]]
-    stats = json.loads((tmp_path / "two" / STATS_FILE).read_text())
+    stats = json.loads((tmp_path / "two" / FUNNEL_PATH).read_text())
     assert stats["core_seconds"] == pytest.approx(2 * stats["wall_seconds"], rel=0.01)
-    with pytest.raises(ConfigError, match="workers"):
-        generate(SHORT, 1, tmp_path / "bad", cfg, workers=0)
+    # the workers are stored with each episode, yet do not change what must match to append
+    assert b.extras(0)["config"]["executor"]["workers"] == 2
+    assert json.loads((tmp_path / "one" / VCAGE_PATH).read_text()) == \
+        json.loads((tmp_path / "two" / VCAGE_PATH).read_text())
+    generate(SHORT, 1, tmp_path / "one", replace(cfg, executor=ExecutorConfig(workers=2)))
     with pytest.raises(ConfigError, match="executor ray"):
-        generate(SHORT, 1, tmp_path / "bad", cfg, address="auto")
+        generate(SHORT, 1, tmp_path / "bad", replace(cfg, executor=ExecutorConfig(address="auto")))
     with pytest.raises(RegistryError, match="valid names: local, ray"):
-        generate(SHORT, 1, tmp_path / "bad", cfg, executor="slurm")
+        generate(SHORT, 1, tmp_path / "bad", replace(cfg, executor=ExecutorConfig("slurm")))
     assert not (tmp_path / "bad" / "meta").exists()
 
 
@@ -100,7 +107,8 @@ def test_ray_executor_makes_the_same_dataset(tmp_path: Path) -> None:
     ray.init(num_cpus=2, include_dashboard=False, log_to_driver=False,
              object_store_memory=128 * 1024 * 1024)
     try:
-        remote = generate(SHORT, 2, tmp_path / "ray", cfg, workers=2, executor="ray")
+        remote = generate(SHORT, 2, tmp_path / "ray",
+                          replace(cfg, executor=ExecutorConfig("ray", workers=2)))
     finally:
         ray.shutdown()
     local = generate(SHORT, 2, tmp_path / "local", cfg)
@@ -116,17 +124,18 @@ def test_append_needs_the_same_config_and_keeps_episodes(tmp_path: Path) -> None
     generate(SHORT, 1, out, GenerateConfig(**SMALL))
     assert DatasetReader(out).num_episodes == 2
     with pytest.raises(DatasetError, match="different configuration"):
-        generate(SHORT, 1, out, GenerateConfig(clutter=5, size=(64, 64)))
+        generate(SHORT, 1, out, replace(GenerateConfig(**SMALL), scene=SceneConfig(clutter=5)))
     assert DatasetReader(out).num_episodes == 2
     assert len((out / ATTEMPTS_LOG).read_text().splitlines()) == 2
 
 
 def test_vanilla_accepts_without_a_critic(tmp_path: Path) -> None:
     out = tmp_path / "vanilla"
-    funnel = generate(SHORT, 1, out, GenerateConfig(mode="vanilla", **SMALL))
+    funnel = generate(SHORT, 1, out, GenerateConfig.vanilla(clutter=2, render=RenderConfig(size=(64, 64))))
     assert funnel.accepted == 1
     extras = DatasetReader(out).extras(0)
-    assert extras["config"]["mode"] == "vanilla" and extras["subtasks"][0]["verdict"] is None
+    assert extras["config"]["critic"] is None and extras["subtasks"][0]["verdict"] is None
+    assert extras["config"]["scene"]["placement"] == "naive" and not extras["config"]["scene"]["check"]
     assert audit(out).judged_subtasks == 0
 
 

@@ -23,7 +23,7 @@ from vcage.scene.layout import (
 from vcage.scene.placement import PlacementConfig, place
 from vcage.scene.placement.geometry import footprint, minkowski_cobstacle, sample_point
 from vcage.scene.spec import ROBOT_MOUNT
-from vcage.skills.reach import reach_map
+from vcage.skills.reachability import reach_map
 
 
 @pytest.fixture(scope="module")

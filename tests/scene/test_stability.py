@@ -9,7 +9,7 @@ from vcage.scene.layout import Distractors, LayoutSpec
 from vcage.scene.placement import place
 from vcage.scene.spec import ObjectSpec, SceneSpec
 from vcage.scene.stability import check_stability
-from vcage.skills.reach import reach_map
+from vcage.skills.reachability import reach_map
 
 
 def _check(scene: SceneSpec):

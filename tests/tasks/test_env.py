@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import subprocess
+import sys
 import warnings
 
 import gymnasium as gym
@@ -9,9 +11,9 @@ import numpy as np
 import pytest
 from gymnasium.utils.env_checker import check_env
 
+from vcage.envs import env_id, register_envs
+from vcage.tasks import run_episode
 from vcage.tasks.env import TaskEnv
-from vcage.tasks.gym_registration import env_id, register_envs
-from vcage.tasks.runner import run_episode
 
 TASK = "stack_blocks_two"
 
@@ -22,12 +24,25 @@ def registered() -> list[str]:
 
 
 def test_register_envs_is_idempotent_and_covers_every_task(registered: list[str]) -> None:
-    from vcage.tasks.base import TASKS
+    from vcage.tasks import TASKS
 
     assert register_envs() == registered  # a second call neither raises nor changes anything
     assert registered == [env_id(name) for name in TASKS.names()]
     assert env_id(TASK) == "vcage/stack_blocks_two-v0"
     assert gym.spec(env_id(TASK)).kwargs == {"task": TASK}
+
+
+def test_a_bare_import_registers_the_environments_in_a_fresh_interpreter() -> None:
+    code = ("import gymnasium as gym, sys; import vcage; "
+            "assert 'mujoco' not in sys.modules, 'registration must not load the simulator'; "
+            f"env = gym.make({env_id(TASK)!r}); obs, info = env.reset(seed=0); print(info['instruction'])")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.strip() == run_episode(TASK, 0).instruction
+    # gymnasium's module:id form imports vcage itself
+    code = f"import gymnasium as gym; gym.make('vcage:{env_id(TASK)}')"
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
 
 
 def test_gymnasium_make_and_check_env() -> None:

@@ -1,1 +1,9 @@
-"""Critics judge a subtask's outcome; the oracle audits every one from simulator state."""
+"""Critics judge each subtask's outcome: the offline image critic, VLM critics, and the oracle.
+
+Importing the package registers the built-in critics in ``CRITICS``.
+"""
+
+from vcage.critics import image, oracle, vlm  # noqa: F401  (register the built-in critics)
+from vcage.critics.base import CRITICS, Critic, CriticConfig, Observation, Verdict, View, make_critic
+
+__all__ = ["CRITICS", "Critic", "CriticConfig", "Observation", "Verdict", "View", "make_critic"]

@@ -14,6 +14,9 @@ from typing import Any
 
 import numpy as np
 
+from vcage.backends import BackendConfig
+from vcage.config import from_fields
+from vcage.errors import ConfigError
 from vcage.planning.schema import Subtask
 from vcage.registry import Registry
 
@@ -23,6 +26,7 @@ class View:
     rgb: np.ndarray  # (H, W, 3) uint8
     segmentation: np.ndarray  # (H, W) int32: object index into Observation.labels, -1 other, -2 robot
     depth: np.ndarray | None = None  # (H, W) metres along the view axis (perspective cameras)
+    pixel_size: float | None = None  # metres per pixel on the table (orthographic cameras)
 
 
 @dataclass(frozen=True)
@@ -57,5 +61,43 @@ class Critic(ABC):
         """Accept or reject the subtask's outcome."""
 
 
-CriticFactory = Callable[..., Critic]
+@dataclass(frozen=True)
+class CriticConfig:
+    """Which critic judges each subtask, and its options.
+
+    ``backend`` is the model endpoint of a model-based critic (``vlm``); when it is None the
+    ``VCAGE_VLM_*`` environment variables are read once, when the run's configuration is resolved,
+    and the result is stored with the dataset like any other option. ``votes``, ``rule`` and
+    ``malformed_verdict`` apply to the ``vlm`` critic: how many times it is asked, how the answers
+    combine (``majority`` or ``all``), and what an unusable answer counts as.
+    """
+
+    name: str = "image"
+    backend: BackendConfig | None = None
+    votes: int = 1
+    rule: str = "majority"
+    malformed_verdict: bool = False
+
+    def __post_init__(self) -> None:
+        CRITICS.get(self.name)  # an unknown name lists the valid ones
+        if isinstance(self.votes, bool) or not isinstance(self.votes, int) or self.votes < 1:
+            raise ConfigError(f"critic votes must be an integer >= 1, got {self.votes!r}")
+        if self.rule not in ("majority", "all"):
+            raise ConfigError(f"critic rule {self.rule!r}; valid: majority, all")
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"name": self.name, "backend": self.backend.to_dict() if self.backend else None,
+                "votes": self.votes, "rule": self.rule, "malformed_verdict": self.malformed_verdict}
+
+    @classmethod
+    def from_dict(cls, data: dict[str, Any]) -> CriticConfig:
+        return from_fields(cls, data, backend=BackendConfig)
+
+
+CriticFactory = Callable[[CriticConfig], Critic]
 CRITICS: Registry[CriticFactory] = Registry("critic")
+
+
+def make_critic(config: CriticConfig) -> Critic:
+    """The critic ``config`` names, built from it."""
+    return CRITICS.get(config.name)(config)

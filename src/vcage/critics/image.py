@@ -13,8 +13,12 @@ It never reads simulator state. Each predicate of the subtask is checked in imag
 - ``upright(x)``: ``x``'s top-view area and front-view height are close to what they were before.
 - ``on_table(a)``: released and not over another object in the top view.
 - ``left_of`` / ``right_of``: column order in the top view (+y, the robot's left, is image left).
+- ``near(a, b)``: the centroids of the two masks in the top view are within the oracle's 10 cm,
+  measured with the orthographic view's pixel size.
+- ``lifted(a)``: in the front view ``a``'s lowest row rose by at least :data:`LIFT_ROWS` pixels
+  since before the subtask, and it is not over another object's top-view hull (it hangs in the air).
 
-Predicates it cannot see (``near``, ``lifted``) are reported as unchecked and do not reject.
+Every predicate of :mod:`vcage.vocabulary` has a check in ``IMAGE_CHECKS``.
 """
 
 from __future__ import annotations
@@ -25,7 +29,8 @@ import numpy as np
 import shapely
 from shapely.geometry import MultiPoint
 
-from vcage.critics.base import CRITICS, Critic, Observation, Verdict, View
+from vcage.critics.base import CRITICS, Critic, CriticConfig, Observation, Verdict, View
+from vcage.registry import Registry
 
 ROBOT = -2
 TOP, FRONT = "top", "front"
@@ -36,20 +41,18 @@ AREA_RATIO = (0.6, 1.6)  # top-view area after / before for an object that staye
 HEIGHT_RATIO = 0.7  # front-view height after / before for an object that stayed upright
 COL_MARGIN = 2  # pixels of column separation for left_of / right_of
 DEPTH_TOL = 0.02  # metres: adjacent pixels this close in depth are in contact
+NEAR = 0.1  # metres between the centroids for ``near`` (the oracle's distance)
+LIFT_ROWS = 8  # front-view pixel rows (of 240) an object's bottom must rise to count as lifted
 
 
 class ImageCritic(Critic):
     name = "image"
 
     def judge(self, obs: Observation) -> Verdict:
-        checks: dict[str, bool | None] = {}
+        checks: dict[str, bool] = {}
         reasons: list[str] = []
         for pred in obs.subtask.predicates:
-            check = CHECKS.get(pred.name)
-            if check is None:
-                checks[str(pred)] = None
-                continue
-            ok, why = check(obs, *pred.args)
+            ok, why = IMAGE_CHECKS.get(pred.name)(obs, *pred.args)
             checks[str(pred)] = ok
             if not ok:
                 reasons.append(f"{pred}: {why}")
@@ -227,13 +230,57 @@ def _side(obs: Observation, a: str, b: str, left: bool) -> tuple[bool, str]:
     return d >= COL_MARGIN, f"column difference {d:.0f} px"
 
 
-CHECKS: dict[str, Callable[..., tuple[bool, str]]] = {
+def _near(obs: Observation, a: str, b: str) -> tuple[bool, str]:
+    top = obs.after.get(TOP)
+    if top is None or top.pixel_size is None:
+        return False, "the orthographic top view is needed"
+    pa, pb = np.nonzero(_mask(obs, top, a)), np.nonzero(_mask(obs, top, b))
+    if not len(pa[0]) or not len(pb[0]):
+        return False, "both objects must be visible from the top"
+    rows = float(np.mean(pa[0]) - np.mean(pb[0]))
+    cols = float(np.mean(pa[1]) - np.mean(pb[1]))
+    d = float(np.hypot(rows, cols)) * top.pixel_size
+    return d <= NEAR, f"{d * 100:.0f} cm apart from the top"
+
+
+def _lifted(obs: Observation, a: str) -> tuple[bool, str]:
+    fb, fa, top = obs.before.get(FRONT), obs.after.get(FRONT), obs.after.get(TOP)
+    if fb is None or fa is None or top is None:
+        return False, "the front views before and after and the top view are needed"
+    rb, ra = _rows(_mask(obs, fb, a)), _rows(_mask(obs, fa, a))
+    if rb is None or ra is None:
+        return False, f"{a} is not visible from the front"
+    rise = rb[1] - ra[1]
+    if rise < LIFT_ROWS:
+        return False, f"{a}'s bottom rose by {rise} px in the front view"
+    ma = _mask(obs, top, a)
+    for i, other in enumerate(obs.labels):
+        mo = top.segmentation == i
+        if other != a and mo.sum() > ma.sum() and (ma & _hull(mo)).sum() > MIN_OVERLAP * ma.sum():
+            return False, f"{a} rests on {other}"
+    return True, f"rose by {rise} px"
+
+
+def _stacked(obs: Observation, *objs: str) -> tuple[bool, str]:
+    for lower, upper in zip(objs, objs[1:], strict=False):
+        ok, why = _on(obs, upper, lower)
+        if not ok:
+            return ok, why
+    return True, "stacked"
+
+
+ImageCheck = Callable[..., tuple[bool, str]]  # (observation, *objects) -> (holds, why)
+IMAGE_CHECKS: Registry[ImageCheck] = Registry("image check")
+_checks: dict[str, ImageCheck] = {
     "on": _on, "inside": _inside, "released": _released, "pressed": _pressed, "upright": _upright,
-    "on_table": _on_table,
+    "on_table": _on_table, "near": _near, "lifted": _lifted, "stacked": _stacked,
     "left_of": lambda obs, a, b: _side(obs, a, b, True),
     "right_of": lambda obs, a, b: _side(obs, a, b, False),
-    "stacked": lambda obs, *objs: next(((ok, why) for lo, up in zip(objs, objs[1:], strict=False)
-                                        for ok, why in [_on(obs, up, lo)] if not ok), (True, "stacked")),
 }
+for _name, _check in _checks.items():
+    IMAGE_CHECKS.add(_name, _check)
 
-CRITICS.add("image", lambda **_: ImageCritic())
+
+@CRITICS.register("image")
+def _image(config: CriticConfig) -> Critic:
+    return ImageCritic()

@@ -5,7 +5,7 @@ Useful as an upper bound and for debugging; the default critics judge from image
 
 from __future__ import annotations
 
-from vcage.critics.base import CRITICS, Critic, Observation, Verdict
+from vcage.critics.base import CRITICS, Critic, CriticConfig, Observation, Verdict
 
 
 class OracleCritic(Critic):
@@ -19,4 +19,6 @@ class OracleCritic(Critic):
         return Verdict(True, "all predicates hold: " + ", ".join(obs.oracle))
 
 
-CRITICS.add("oracle", lambda **_: OracleCritic())
+@CRITICS.register("oracle")
+def _oracle(config: CriticConfig) -> Critic:
+    return OracleCritic()

@@ -11,37 +11,23 @@ from __future__ import annotations
 
 import json
 import re
-from dataclasses import dataclass
 from typing import Any
 
 from vcage.backends import BackendConfig, ChatBackend, Message, connect
-from vcage.critics.base import CRITICS, Critic, Observation, Verdict
-from vcage.errors import BackendError, ConfigError
+from vcage.critics.base import CRITICS, Critic, CriticConfig, Observation, Verdict
+from vcage.errors import BackendError
 
 SYSTEM = ("You verify the outcome of a robot manipulation step on a tabletop from camera images. "
           "Look only at the images. Reply with a JSON object {\"success\": true or false, "
           "\"reason\": \"one short sentence\"} and nothing else.")
 
 
-@dataclass(frozen=True)
-class VLMCriticConfig:
-    votes: int = 1
-    rule: str = "majority"  # "majority" | "all"
-    malformed_verdict: bool = False  # what an unusable answer counts as (False: reject)
-
-    def __post_init__(self) -> None:
-        if self.votes < 1:
-            raise ConfigError(f"votes must be >= 1, got {self.votes}")
-        if self.rule not in ("majority", "all"):
-            raise ConfigError(f"rule {self.rule!r}; valid: majority, all")
-
-
 class VLMCritic(Critic):
     name = "vlm"
 
-    def __init__(self, backend: ChatBackend, config: VLMCriticConfig | None = None) -> None:
+    def __init__(self, backend: ChatBackend, config: CriticConfig | None = None) -> None:
         self.backend = backend
-        self.config = config or VLMCriticConfig()
+        self.config = config or CriticConfig("vlm")
 
     def judge(self, obs: Observation) -> Verdict:
         messages = [Message("system", SYSTEM), self._question(obs)]
@@ -98,9 +84,9 @@ def parse_answer(reply: str) -> dict[str, Any] | None:
     return {"success": value, "reason": str(data.get("reason", ""))[:300]}
 
 
-def _from_env(**kw: Any) -> VLMCritic:
-    backend = kw.get("backend") or connect(BackendConfig.from_env("VCAGE_VLM"))
-    return VLMCritic(backend, kw.get("config"))
+ENV_PREFIX = "VCAGE_VLM"  # where the endpoint is read from when the config names none
 
 
-CRITICS.add("vlm", _from_env)
+@CRITICS.register("vlm")
+def _vlm(config: CriticConfig) -> Critic:
+    return VLMCritic(connect(config.backend or BackendConfig.from_env(ENV_PREFIX)), config)

@@ -23,14 +23,12 @@ import numpy as np
 import pyarrow as pa
 import pyarrow.parquet as pq
 
-from vcage.data import reader as layout
+from vcage.data import layout, video
 from vcage.data import stats as st
-from vcage.data import video
 from vcage.data.files import TMP_MARK, atomic_write, diff, tasks_table, to_json, write_json, write_table
-from vcage.data.reader import STANDARD_COLUMNS, DatasetReader, Feature, load_json
+from vcage.data.reader import DTYPES, STANDARD_COLUMNS, DatasetReader, Feature, load_json
 from vcage.errors import DatasetError
 
-LOCK_PATH = "meta/.vcage.lock"
 _EPISODE_FILE = re.compile(
     r"(?:chunk-(\d+)/file-(\d+)\.(?:parquet|mp4)|episode_(\d+)(?:_states\.npz|\.json))$")
 
@@ -86,7 +84,7 @@ class DatasetWriter:
 
     def _lock(self) -> None:
         """Hold an exclusive lock on the dataset so that two writers never append at once."""
-        fd = os.open(self.root / LOCK_PATH, os.O_RDWR | os.O_CREAT, 0o644)
+        fd = os.open(self.root / layout.LOCK_PATH, os.O_RDWR | os.O_CREAT, 0o644)
         try:
             fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except OSError:
@@ -249,7 +247,7 @@ class DatasetWriter:
                     length: int) -> pa.Table:
         columns: dict[str, pa.Array] = {}
         for key, feature in self.features.items():
-            flat = pa.array(arrays[key].reshape(-1), layout.DTYPES[feature.dtype])
+            flat = pa.array(arrays[key].reshape(-1), DTYPES[feature.dtype])
             n = feature.shape[0]
             columns[key] = flat if n == 1 else pa.FixedSizeListArray.from_arrays(flat, n)
         frame_index = np.arange(length, dtype=np.int64)

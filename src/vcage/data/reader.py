@@ -16,20 +16,17 @@ import pyarrow as pa
 import pyarrow.compute as pc
 import pyarrow.parquet as pq
 
+from vcage.data.layout import (
+    ARRAYS_PATH,
+    CODEBASE_VERSION,
+    EXTRAS_PATH,
+    INFO_PATH,
+    TASKS_PATH,
+    VCAGE_PATH,
+)
 from vcage.data.video import decode_video
 from vcage.errors import DatasetError
 
-CODEBASE_VERSION = "v3.0"
-CHUNKS_SIZE = 1000
-DATA_PATH = "data/chunk-{chunk_index:03d}/file-{file_index:03d}.parquet"
-VIDEO_PATH = "videos/{video_key}/chunk-{chunk_index:03d}/file-{file_index:03d}.mp4"
-EPISODES_PATH = "meta/episodes/chunk-{chunk_index:03d}/file-{file_index:03d}.parquet"
-INFO_PATH = "meta/info.json"
-TASKS_PATH = "meta/tasks.parquet"
-STATS_PATH = "meta/stats.json"
-VCAGE_PATH = "meta/vcage.json"
-EXTRAS_PATH = "extras/episode_{episode_index:06d}.json"
-ARRAYS_PATH = "extras/episode_{episode_index:06d}_states.npz"
 DTYPES = {"float32": pa.float32(), "float64": pa.float64(), "int32": pa.int32(), "int64": pa.int64(),
           "bool": pa.bool_()}
 # Columns every LeRobot frame row has, besides the features.

@@ -12,8 +12,9 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any
 
+from vcage.data.layout import ATTEMPTS_LOG
 from vcage.errors import DatasetError
-from vcage.pipeline.generate import ATTEMPTS_LOG
+from vcage.pipeline.stage import Stage
 
 
 @dataclass(frozen=True)
@@ -75,7 +76,7 @@ def audit(root: Path) -> AuditReport:
         except json.JSONDecodeError:
             raise DatasetError(f"{path} line {n} is not JSON; the log is corrupt") from None
         counts["attempts"] += 1
-        if rec["stage"] == "accepted":
+        if rec["stage"] == Stage.ACCEPTED:
             counts["accepted"] += 1
             counts["accepted_oracle_failed"] += not rec["oracle_success"]
         for audit_row, verdict in zip(rec["audit"], rec["verdicts"], strict=False):

@@ -1,63 +1,120 @@
-"""What a generation run does, as data: stored with the dataset and compared on append."""
+"""The configuration tree of a generation run, as data: stored with the dataset, compared on append.
+
+Every option that changes the data is a field here, grouped by the stage it configures: planner
+(with its model endpoint), scene, critic (with its endpoint and options), render, sim and
+randomisation; the executor says where episodes run (it does not change the data). Model endpoints
+left unset are read from the environment once, by :meth:`GenerateConfig.resolved`, and stored like
+any other option; API keys are read from the environment when a request is made and never stored.
+The Vanilla baseline is a preset, :meth:`GenerateConfig.vanilla`, not a mode that rewrites fields.
+"""
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 from typing import Any
 
-from vcage.config import Randomization
-from vcage.errors import ConfigError
+import numpy as np
 
-MODES = ("vcage", "vanilla")
+from vcage.backends import BackendConfig
+from vcage.config import Randomization, RenderConfig, SimConfig, from_fields
+from vcage.critics.base import CriticConfig
+from vcage.critics.vlm import ENV_PREFIX as VLM_ENV_PREFIX
+from vcage.errors import ConfigError
+from vcage.planning import LLM_ENV_PREFIX, PlannerConfig
+from vcage.scene.instantiate import SceneConfig
+
+SEED_LIMIT = 2**32  # seeds are unsigned 32-bit, as numpy's SeedSequence entropy
+
+
+@dataclass(frozen=True)
+class ExecutorConfig:
+    """Where episodes run: ``local`` (this machine; more than one worker: processes) or ``ray``
+    (``address``: a running cluster's; none: a local Ray instance), at most ``workers`` at once."""
+
+    name: str = "local"
+    workers: int = 1
+    address: str | None = None
+
+    def __post_init__(self) -> None:
+        workers = self.workers
+        if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
+            raise ConfigError(f"workers must be a positive integer, got {workers!r}")
+
+    def to_dict(self) -> dict[str, Any]:
+        return asdict(self)
+
+    @classmethod
+    def from_dict(cls, data: dict[str, Any]) -> ExecutorConfig:
+        return from_fields(cls, data)
 
 
 @dataclass(frozen=True)
 class GenerateConfig:
-    """``mode="vanilla"`` is the paper's baseline: naive placement, no scene check, no critic
-    (an episode is accepted when no exception occurred); ``vcage`` uses ``placement`` and ``critic``."""
+    """A generation run. ``critic=None`` accepts every attempt that raised no exception (Vanilla).
 
-    mode: str = "vcage"
-    planner: str = "offline"
-    critic: str = "image"
-    placement: str = "context"
-    clutter: int = 4
+    Each episode gets up to ``max_attempts`` attempts (scene re-samples) before it is given up;
+    attempt seeds derive from ``seed`` (:meth:`episode_seed`).
+    """
+
     seed: int = 0
-    max_attempts: int = 10  # scene re-samples per episode before the episode is given up
-    cameras: tuple[str, ...] = ("front", "panda/wrist")  # recorded as videos
-    size: tuple[int, int] = (128, 128)  # width, height of the videos
-    critic_size: tuple[int, int] = (320, 240)  # width, height of the critic's views
+    max_attempts: int = 10
+    planner: PlannerConfig = field(default_factory=PlannerConfig)
+    scene: SceneConfig = field(default_factory=lambda: SceneConfig(clutter=4))
+    critic: CriticConfig | None = field(default_factory=CriticConfig)
+    render: RenderConfig = field(default_factory=RenderConfig)
+    sim: SimConfig = field(default_factory=SimConfig)
     randomization: Randomization = field(default_factory=Randomization)
+    executor: ExecutorConfig = field(default_factory=ExecutorConfig)
 
     def __post_init__(self) -> None:
-        if self.mode not in MODES:
-            raise ConfigError(f"mode {self.mode!r}; valid: {', '.join(MODES)}")
-        if self.clutter < 0 or self.max_attempts < 1:
-            raise ConfigError("clutter must be >= 0 and max_attempts >= 1")
-        if any(v <= 0 or v % 2 for v in self.size):
-            raise ConfigError(f"video size {self.size} must be positive and even")
-        if not self.cameras:
-            raise ConfigError("record at least one camera")
+        seed = self.seed
+        if isinstance(seed, bool) or not isinstance(seed, int) or not 0 <= seed < SEED_LIMIT:
+            raise ConfigError(f"seed must be an integer in [0, 2**32), got {seed!r}")
+        attempts = self.max_attempts
+        if isinstance(attempts, bool) or not isinstance(attempts, int) or attempts < 1:
+            raise ConfigError(f"max_attempts must be an integer >= 1, got {attempts!r}")
+
+    @classmethod
+    def vanilla(cls, **fields: Any) -> GenerateConfig:
+        """The paper's baseline: naive placement, no scene check, no critic (``fields`` override;
+        ``clutter`` sets the scene's clutter)."""
+        scene = SceneConfig(placement="naive", clutter=fields.pop("clutter", 4), check=False)
+        return cls(**{"scene": scene, "critic": None, **fields})
 
     @property
-    def placement_method(self) -> str:
-        return "naive" if self.mode == "vanilla" else self.placement
+    def mode(self) -> str:
+        """``vanilla`` for a run without critic, else ``vcage`` (a label for reports)."""
+        return "vanilla" if self.critic is None else "vcage"
 
-    @property
-    def check_scene(self) -> bool:
-        return self.mode == "vcage"
-
-    @property
-    def critic_name(self) -> str | None:
-        return None if self.mode == "vanilla" else self.critic
+    def resolved(self) -> GenerateConfig:
+        """This config with unset model endpoints read from the environment (``VCAGE_LLM_*`` for the
+        LLM planner, ``VCAGE_VLM_*`` for the VLM critic), so the run records what it used."""
+        cfg = self
+        if cfg.planner.name == "llm" and cfg.planner.backend is None:
+            cfg = replace(cfg, planner=replace(cfg.planner, backend=BackendConfig.from_env(LLM_ENV_PREFIX)))
+        if cfg.critic is not None and cfg.critic.name == "vlm" and cfg.critic.backend is None:
+            cfg = replace(cfg, critic=replace(cfg.critic, backend=BackendConfig.from_env(VLM_ENV_PREFIX)))
+        return cfg
 
     def to_dict(self) -> dict[str, Any]:
-        d = asdict(self)
-        for key in ("cameras", "size", "critic_size"):
-            d[key] = list(d[key])
-        return d
+        return {"seed": self.seed, "max_attempts": self.max_attempts,
+                "planner": self.planner.to_dict(), "scene": self.scene.to_dict(),
+                "critic": self.critic.to_dict() if self.critic else None,
+                "render": self.render.to_dict(), "sim": self.sim.to_dict(),
+                "randomization": self.randomization.to_dict(), "executor": self.executor.to_dict()}
+
+    def data_dict(self) -> dict[str, Any]:
+        """What must match to append to a dataset: everything but where episodes ran."""
+        data = self.to_dict()
+        del data["executor"]
+        return data
+
+    @classmethod
+    def from_dict(cls, data: dict[str, Any]) -> GenerateConfig:
+        return from_fields(cls, data, planner=PlannerConfig, scene=SceneConfig, critic=CriticConfig,
+                           render=RenderConfig, sim=SimConfig, randomization=Randomization,
+                           executor=ExecutorConfig)
 
     def episode_seed(self, episode: int, attempt: int) -> int:
         """The seed of an attempt: derived from the run seed, the episode and the attempt index."""
-        import numpy as np
-
         return int(np.random.SeedSequence([self.seed, episode, attempt]).generate_state(1)[0])

@@ -1,35 +1,32 @@
 """One attempt at an episode: scene, execution with a critic after every subtask, oracle audit.
 
-An attempt ends in one stage: ``placement`` (the layout could not be placed), ``scene`` (the
-placed scene failed the physics check), ``skill`` (a skill could not plan), ``physics`` (the
-simulation became unstable), ``critic`` (a subtask was rejected), or ``accepted``.
+An attempt ends in one :class:`~vcage.pipeline.stage.Stage`: the layout could not be placed, the
+placed scene failed the physics check, a skill could not plan, the simulation became unstable, the
+critic rejected a subtask, or it was accepted.
 """
 
 from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field
-from typing import Any
 
 import numpy as np
 
-from vcage.critics.base import Critic, Observation, View
+from vcage.critics.base import Critic
 from vcage.errors import PlacementError, SimulationError
 from vcage.pipeline.config import GenerateConfig
-from vcage.pipeline.rollout import Rollout, SubtaskOutcome, run_plan
-from vcage.pipeline.scene import plan_layout
-from vcage.planning.schema import Plan, Subtask
-from vcage.scene.compose import compose
-from vcage.scene.placement import place
+from vcage.pipeline.plan_layout import plan_layout
+from vcage.pipeline.rollout import Rollout, run_plan
+from vcage.pipeline.stage import Stage
+from vcage.pipeline.verifier import Verifier
+from vcage.planning.schema import Plan
+from vcage.scene.instantiate import Instantiator, SceneInstance
 from vcage.scene.spec import SceneSpec
-from vcage.scene.stability import StabilityConfig, check_stability
 from vcage.sim.render import Renderer
 from vcage.sim.world import World
-from vcage.skills.executor import Executor, Recording
+from vcage.skills.playback import Player, Recording
 from vcage.skills.primitives import Skills
-from vcage.skills.reach import reach_map
-
-SETTLE_SECONDS = 0.3
+from vcage.skills.reachability import reach_map
 
 
 @dataclass
@@ -49,7 +46,7 @@ class Timing:
 @dataclass
 class Attempt:
     seed: int
-    stage: str  # placement | scene | skill | physics | critic | accepted
+    stage: Stage
     reason: str
     scene: SceneSpec | None = None
     rollout: Rollout | None = None
@@ -60,7 +57,7 @@ class Attempt:
 
     @property
     def accepted(self) -> bool:
-        return self.stage == "accepted"
+        return self.stage is Stage.ACCEPTED
 
     @property
     def oracle_success(self) -> bool:
@@ -79,101 +76,48 @@ def attempt(plan: Plan, seed: int, cfg: GenerateConfig, critic: Critic | None) -
 
 def _attempt(plan: Plan, seed: int, cfg: GenerateConfig, critic: Critic | None, timing: Timing) -> Attempt:
     rng = np.random.default_rng(seed)
-    layout = plan_layout(plan, rng, cfg.randomization, cfg.clutter)
+    layout = plan_layout(plan, rng, cfg.randomization, cfg.scene.clutter)
+    instantiator = Instantiator(cfg.scene, cfg.sim, reach_map())
     try:
-        scene = place(layout, rng, cfg.placement_method, reach=reach_map()).scene
+        spec, stats = instantiator.place(layout, rng)
     except PlacementError as exc:
-        return Attempt(seed, "placement", str(exc))
+        return Attempt(seed, Stage.PLACEMENT, str(exc))
     try:
-        world = compose(scene).make_world()
+        instance = instantiator.realize(spec, stats)
     except SimulationError as exc:
-        return Attempt(seed, "physics", str(exc), scene)
+        return Attempt(seed, Stage.PHYSICS, str(exc), spec)
     try:
-        return _execute(plan, seed, cfg, critic, timing, scene, world)
+        return _execute(plan, seed, cfg, critic, timing, instance)
     finally:
-        timing.physics += world.physics_seconds
+        timing.physics += instance.world.physics_seconds
 
 
 def _execute(plan: Plan, seed: int, cfg: GenerateConfig, critic: Critic | None, timing: Timing,
-             scene: SceneSpec, world: World) -> Attempt:
+             instance: SceneInstance) -> Attempt:
+    scene, world = instance.spec, instance.world
+    if not instance.valid:
+        assert instance.stability is not None
+        return Attempt(seed, Stage.SCENE, instance.stability.reason(), scene)
     try:
-        if cfg.check_scene:
-            report = check_stability(world, StabilityConfig(settle_seconds=SETTLE_SECONDS))
-            if not report.ok:
-                return Attempt(seed, "scene", report.reason(), scene)
-        else:
-            world.settle(SETTLE_SECONDS)
         initial = world.get_state()
-        skills = Skills(world, Executor(world, record_states=True))
-        renderer = Renderer(world, *cfg.critic_size) if critic is not None and critic.needs_views else None
+        skills = Skills(world, Player(world, record_states=True))
+        renderer = (Renderer(world, *cfg.render.critic_size)
+                    if critic is not None and critic.needs_views else None)
         try:
-            judge = Judge(world, plan, critic, renderer, timing) if critic is not None else None
-            if judge is not None:
-                judge.skills_recording = skills.executor.recording
-            rollout, skills = run_plan(world, plan, skills, judge,
-                                       on_subtask_start=judge.start if judge else None)
+            verifier = (Verifier(world, plan, critic, renderer, skills.player.recording, timing)
+                        if critic is not None else None)
+            rollout = run_plan(world, plan, skills, verifier)
         finally:
             if renderer is not None:
                 renderer.close()
     except SimulationError as exc:
-        return Attempt(seed, "physics", str(exc), scene)
-    out = Attempt(seed, "accepted", "", scene, rollout, skills.executor.recording, world, initial)
+        return Attempt(seed, Stage.PHYSICS, str(exc), scene)
+    out = Attempt(seed, Stage.ACCEPTED, "", scene, rollout, skills.player.recording, world, initial)
     if rollout.aborted_at is not None:
         last = rollout.outcomes[-1]
         if last.skill_error is not None:
-            out.stage, out.reason = "skill", last.skill_error
+            out.stage, out.reason = Stage.SKILL, last.skill_error
         else:
             verdict = last.verdict or {}
-            out.stage, out.reason = "critic", f"subtask {last.index + 1}: {verdict.get('reason', '')}"
+            out.stage, out.reason = Stage.CRITIC, f"subtask {last.index + 1}: {verdict.get('reason', '')}"
     return out
-
-
-class Judge:
-    """Renders the views a critic needs before and after each subtask and asks it."""
-
-    def __init__(self, world: World, plan: Plan, critic: Critic, renderer: Renderer | None,
-                 timing: Timing) -> None:
-        self.world, self.plan, self.critic = world, plan, critic
-        self.renderer, self.timing = renderer, timing
-        self._before: dict[str, View] = {}
-        self.skills_recording: Recording | None = None
-
-    def _views(self) -> dict[str, View]:
-        if self.renderer is None:
-            return {}
-        t0 = time.perf_counter()
-        views = {cam: View(self.renderer.rgb(cam), self.renderer.segmentation(cam),
-                           self.renderer.depth(cam) if cam in DEPTH_CAMERAS else None)
-                 for cam in CRITIC_CAMERAS}
-        self.timing.render += time.perf_counter() - t0
-        return views
-
-    def start(self, index: int, subtask: Subtask) -> None:
-        self._before = self._views()
-
-    def __call__(self, outcome: SubtaskOutcome) -> dict[str, Any]:
-        obs = Observation(subtask=self.plan.subtasks[outcome.index], labels=tuple(self.world.object_names),
-                          before=self._before, after=self._views(), during=self._deepest(outcome),
-                          oracle=outcome.oracle)
-        return self.critic.judge(obs).to_dict()
-
-    def _deepest(self, outcome: SubtaskOutcome) -> dict[str, View]:
-        """Views of the recorded frame where the hand was lowest during the subtask (e.g. a press).
-
-        The frame is chosen from proprioception (the hand's height), as on a real robot.
-        """
-        rec = self.skills_recording
-        if self.renderer is None or rec is None or outcome.end <= outcome.start or not rec.states:
-            return {}
-        heights = [p[2] for p in rec.ee_pos[outcome.start:outcome.end]]
-        frame = outcome.start + int(np.argmin(heights))
-        now = self.world.get_state()
-        self.world.set_state(rec.states[frame])
-        try:
-            return self._views()
-        finally:
-            self.world.set_state(now)
-
-
-CRITIC_CAMERAS = ("top", "front")  # the views a critic gets: top-down (orthographic) and front
-DEPTH_CAMERAS = ("front",)  # ... with depth where the camera is perspective (RGB-D)

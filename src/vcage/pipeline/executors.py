@@ -18,10 +18,10 @@ from collections.abc import Callable, Iterator
 from concurrent.futures import Future, ProcessPoolExecutor
 from typing import Any, TypeVar
 
-from vcage.critics.base import Critic
+from vcage.critics import Critic
 from vcage.errors import ConfigError
-from vcage.pipeline.config import GenerateConfig
-from vcage.pipeline.sampling import EpisodeRun, make_critic, run_episode
+from vcage.pipeline.config import ExecutorConfig, GenerateConfig
+from vcage.pipeline.sampling import EpisodeRun, build_critic, sample_episode
 from vcage.planning.schema import Plan
 from vcage.registry import Registry
 
@@ -30,12 +30,11 @@ H = TypeVar("H")  # an executor's handle on a submitted episode
 
 
 class EpisodeExecutor(ABC):
-    """Runs episodes, at most ``workers`` at once."""
+    """Runs episodes, at most ``config.workers`` at once."""
 
-    def __init__(self, workers: int = 1, address: str | None = None) -> None:
-        if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
-            raise ConfigError(f"workers must be a positive integer, got {workers!r}")
-        self.workers, self.address = workers, address
+    def __init__(self, config: ExecutorConfig) -> None:
+        self.config = config
+        self.workers, self.address = config.workers, config.address
 
     @abstractmethod
     def runs(self, plan: Plan, cfg: GenerateConfig, indices: range,
@@ -50,20 +49,25 @@ class EpisodeExecutor(ABC):
 EXECUTORS: Registry[type[EpisodeExecutor]] = Registry("executor")
 
 
+def make_executor(config: ExecutorConfig) -> EpisodeExecutor:
+    """The executor ``config`` names; checks its settings before any work."""
+    return EXECUTORS.get(config.name)(config)
+
+
 @EXECUTORS.register("local")
 class LocalExecutor(EpisodeExecutor):
     """One worker: episodes in this process; more: that many worker processes on this machine."""
 
-    def __init__(self, workers: int = 1, address: str | None = None) -> None:
-        super().__init__(workers, address)
-        if address is not None:
+    def __init__(self, config: ExecutorConfig) -> None:
+        super().__init__(config)
+        if config.address is not None:
             raise ConfigError("the local executor runs on this machine; an address needs --executor ray")
 
     def runs(self, plan: Plan, cfg: GenerateConfig, indices: range,
              critic: Critic | None) -> Iterator[EpisodeRun]:
         if self.workers == 1:
             for k in indices:
-                yield run_episode(plan, k, cfg, critic)
+                yield sample_episode(plan, k, cfg, critic)
             return
         context = multiprocessing.get_context("spawn")  # fresh processes: no GL context is forked
         with ProcessPoolExecutor(self.workers, mp_context=context) as pool:
@@ -80,8 +84,8 @@ class RayExecutor(EpisodeExecutor):
     Ray must be installed (``pip install 'vcage[ray]'``).
     """
 
-    def __init__(self, workers: int = 1, address: str | None = None) -> None:
-        super().__init__(workers, address)
+    def __init__(self, config: ExecutorConfig) -> None:
+        super().__init__(config)
         try:
             import ray
         except ImportError as exc:
@@ -135,7 +139,7 @@ _CRITICS: dict[str, Any] = {}
 
 def _episode(plan: Plan, cfg: GenerateConfig, index: int) -> EpisodeRun:
     os.environ.setdefault("LP_NUM_THREADS", "1")  # one rasteriser thread: a worker is one core
-    key = repr(cfg)
+    key = repr(cfg.critic)
     if key not in _CRITICS:
-        _CRITICS[key] = make_critic(cfg)
-    return run_episode(plan, index, cfg, _CRITICS[key])
+        _CRITICS[key] = build_critic(cfg)
+    return sample_episode(plan, index, cfg, _CRITICS[key])

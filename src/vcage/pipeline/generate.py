@@ -3,7 +3,7 @@
 Each episode gets up to ``max_attempts`` attempts with derived seeds (:mod:`.sampling`); an
 accepted one is written to the dataset atomically, in episode order. Every attempt, accepted or
 not, is logged with its oracle audit in ``meta/vcage_attempts.jsonl``; the funnel goes to
-``stats.json``.
+``stats.json`` (paths in :mod:`vcage.data.layout`).
 """
 
 from __future__ import annotations
@@ -18,15 +18,14 @@ from pathlib import Path
 from typing import Any
 
 from vcage.data import DatasetWriter
+from vcage.data.layout import ATTEMPTS_LOG, FUNNEL_PATH
 from vcage.pipeline.config import GenerateConfig
 from vcage.pipeline.episode import Timing
-from vcage.pipeline.executors import EXECUTORS
-from vcage.pipeline.sampling import FEATURES, EpisodeRun, camera_key, make_critic
+from vcage.pipeline.executors import make_executor
+from vcage.pipeline.sampling import FEATURES, EpisodeRun, build_critic, camera_key
+from vcage.pipeline.stage import Stage
 from vcage.planning import make_planner
 from vcage.planning.schema import Plan
-
-ATTEMPTS_LOG = "meta/vcage_attempts.jsonl"
-STATS_FILE = "stats.json"
 
 
 @dataclass
@@ -71,25 +70,27 @@ class Funnel:
 Progress = Callable[[Funnel], None]
 
 
-def generate(instruction: str, episodes: int, out: Path, cfg: GenerateConfig,
-             progress: Progress | None = None, plan: Plan | None = None, workers: int = 1,
-             executor: str = "local", address: str | None = None) -> Funnel:
+def generate(instruction: str, episodes: int, out: Path | str, cfg: GenerateConfig,
+             progress: Progress | None = None, plan: Plan | None = None) -> Funnel:
     """Generate ``episodes`` accepted episodes into the dataset at ``out``; returns the funnel.
 
-    ``executor`` (``local`` or ``ray``, see :mod:`vcage.pipeline.executors`) runs up to ``workers``
-    episodes at once (``address``: a Ray cluster's). Each episode's attempts depend only on its
-    seeds, so the dataset is the same for any executor and number of workers.
+    ``cfg.executor`` runs up to ``cfg.executor.workers`` episodes at once (see
+    :mod:`vcage.pipeline.executors`). Each episode's attempts depend only on its seeds, so the
+    dataset is the same for any executor and number of workers. The resolved configuration
+    (model endpoints included, keys never) is stored with the dataset and every episode.
     """
-    pool = EXECUTORS.get(executor)(workers, address)  # checks the arguments before any work
+    out = Path(out)
+    cfg = cfg.resolved()
+    pool = make_executor(cfg.executor)  # checks the arguments before any work
     t0 = time.perf_counter()
     plan = plan or make_planner(cfg.planner).plan(instruction)
-    critic = make_critic(cfg)  # a misconfigured critic (e.g. no API key) fails here, before any work
-    width, height = cfg.size
-    funnel = Funnel(episodes_requested=episodes, workers=workers)
-    with DatasetWriter(out, fps=_fps(), features=FEATURES,
-                       cameras={camera_key(c): (height, width) for c in cfg.cameras},
+    critic = build_critic(cfg)  # a misconfigured critic (e.g. no API key) fails here, before any work
+    width, height = cfg.render.size
+    funnel = Funnel(episodes_requested=episodes, workers=cfg.executor.workers)
+    with DatasetWriter(out, fps=int(cfg.sim.control_hz), features=FEATURES,
+                       cameras={camera_key(c): (height, width) for c in cfg.render.cameras},
                        robot_type="franka_panda",
-                       config={"generate": cfg.to_dict(), "plan": plan.model_dump(mode="json")}) as writer:
+                       config={"generate": cfg.data_dict(), "plan": plan.model_dump(mode="json")}) as writer:
         first = writer.num_episodes
         for run in pool.runs(plan, cfg, range(first, first + episodes), critic):
             _record(out, writer, plan, run, funnel)
@@ -97,7 +98,7 @@ def generate(instruction: str, episodes: int, out: Path, cfg: GenerateConfig,
             if progress is not None:
                 progress(funnel)
     funnel.wall = time.perf_counter() - t0
-    (out / STATS_FILE).write_text(json.dumps(funnel.to_dict(), indent=2))
+    (out / FUNNEL_PATH).write_text(json.dumps(funnel.to_dict(), indent=2))
     return funnel
 
 
@@ -116,17 +117,11 @@ def _record(out: Path, writer: DatasetWriter, plan: Plan, run: EpisodeRun, funne
     writer.add_episode(ep.frames, ep.videos, task=plan.instruction, extras=ep.extras, arrays=ep.arrays)
 
 
-def _fps() -> int:
-    from vcage.config import SimConfig
-
-    return int(SimConfig().control_hz)
-
-
 def _count(funnel: Funnel, record: dict[str, Any], timing: Timing) -> None:
     funnel.attempts += 1
     funnel.stages[record["stage"]] += 1
     funnel.timing.add(timing)
-    if record["stage"] == "accepted":
+    if record["stage"] == Stage.ACCEPTED:
         funnel.accepted += 1
         if not record["oracle_success"]:
             funnel.accepted_oracle_failed += 1

@@ -1,25 +1,23 @@
 """Execute a plan's subtasks in order on a world, auditing each one with the oracle.
 
 After every subtask the command is held for a moment (success must hold on consecutive control
-steps), the oracle's verdict is recorded with the subtask's frame boundaries, and an optional
-``judge`` (the critic) decides whether to go on. A skill that cannot plan ends the rollout.
+steps, :func:`vcage.tasks.success.held`), the oracle's verdict is recorded with the subtask's frame
+boundaries, and an optional verifier (the critic) decides whether to go on. A skill that cannot
+plan ends the rollout.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from dataclasses import dataclass, field
 from functools import partial
-from typing import Any
+from typing import Any, Protocol
 
-from vcage.critics.oracle import Oracle
 from vcage.errors import SkillError
 from vcage.planning.schema import Plan, Subtask
 from vcage.sim.world import World
 from vcage.skills.primitives import Skills
-from vcage.tasks.runner import held
-
-HOLD_STEPS = 5  # the oracle's predicates must hold this many consecutive control steps
+from vcage.tasks.oracle import Oracle
+from vcage.tasks.success import held
 
 
 @dataclass
@@ -38,46 +36,50 @@ class SubtaskOutcome:
 @dataclass
 class Rollout:
     outcomes: list[SubtaskOutcome] = field(default_factory=list)
-    aborted_at: int | None = None  # index of the subtask after which the judge stopped it
+    aborted_at: int | None = None  # index of the subtask after which the verifier stopped it
 
     @property
     def oracle_success(self) -> bool:
         return bool(self.outcomes) and all(o.oracle_success for o in self.outcomes)
 
 
-Judge = Callable[[SubtaskOutcome], dict[str, Any]]  # returns a verdict with a boolean "accept"
+class SubtaskVerifier(Protocol):
+    def start(self, index: int, subtask: Subtask) -> None: ...
+
+    def judge(self, outcome: SubtaskOutcome) -> dict[str, Any]:
+        """A verdict with a boolean ``"accept"``."""
 
 
-def run_plan(world: World, plan: Plan, skills: Skills | None = None, judge: Judge | None = None,
-             on_subtask_start: Callable[[int, Subtask], None] | None = None) -> tuple[Rollout, Skills]:
+def run_plan(world: World, plan: Plan, skills: Skills | None = None,
+             verifier: SubtaskVerifier | None = None) -> Rollout:
     skills = skills or Skills(world)
     oracle = Oracle()
-    skills.executor.hooks.append(oracle.on_step)
+    skills.player.hooks.append(oracle.on_step)
     rollout = Rollout()
     for i, sub in enumerate(plan.subtasks):
-        if on_subtask_start is not None:
-            on_subtask_start(i, sub)
-        oracle.begin(sub)
-        start = len(skills.executor.recording)
+        if verifier is not None:
+            verifier.start(i, sub)
+        oracle.begin(sub.predicates)
+        start = len(skills.player.recording)
         error = None
         try:
             skills.do(sub.skill, **_skill_args(sub))
             skills.do("retreat")  # back home: the views after the subtask show it unobstructed
         except SkillError as exc:
             error = str(exc)
-        values, _ = held(skills, partial(oracle.check, world, sub), HOLD_STEPS)
-        outcome = SubtaskOutcome(i, sub.skill, sub.description, start, len(skills.executor.recording),
+        values, _ = held(skills, partial(oracle.check, world, sub.predicates))
+        outcome = SubtaskOutcome(i, sub.skill, sub.description, start, len(skills.player.recording),
                                  values, error is None and all(values.values()), error)
         rollout.outcomes.append(outcome)
         if error is not None:
             rollout.aborted_at = i
             break
-        if judge is not None:
-            outcome.verdict = judge(outcome)
+        if verifier is not None:
+            outcome.verdict = verifier.judge(outcome)
             if not outcome.verdict.get("accept", False):
                 rollout.aborted_at = i
                 break
-    return rollout, skills
+    return rollout
 
 
 def _skill_args(sub: Subtask) -> dict[str, Any]:

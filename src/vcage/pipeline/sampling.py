@@ -14,8 +14,7 @@ from typing import Any
 
 import numpy as np
 
-from vcage.critics import ground_truth, image, vlm  # noqa: F401  (register the critics)
-from vcage.critics.base import CRITICS, Critic
+from vcage.critics import Critic, make_critic
 from vcage.data import Feature
 from vcage.pipeline.config import GenerateConfig
 from vcage.pipeline.episode import Attempt, Timing, attempt
@@ -56,7 +55,7 @@ class EpisodeRun:
     video_seconds: float = 0.0
 
 
-def run_episode(plan: Plan, index: int, cfg: GenerateConfig, critic: Critic | None) -> EpisodeRun:
+def sample_episode(plan: Plan, index: int, cfg: GenerateConfig, critic: Critic | None) -> EpisodeRun:
     """Attempt episode ``index`` with its derived seeds until one attempt is accepted or the bound."""
     run = EpisodeRun(index)
     for j in range(cfg.max_attempts):
@@ -71,9 +70,9 @@ def run_episode(plan: Plan, index: int, cfg: GenerateConfig, critic: Critic | No
     return run
 
 
-def make_critic(cfg: GenerateConfig) -> Critic | None:
+def build_critic(cfg: GenerateConfig) -> Critic | None:
     """The critic ``cfg`` names, or None (Vanilla)."""
-    return CRITICS.get(cfg.critic_name)() if cfg.critic_name else None
+    return make_critic(cfg.critic) if cfg.critic is not None else None
 
 
 def _audit(result: Attempt) -> list[dict[str, Any]]:
@@ -117,11 +116,12 @@ def episode_data(plan: Plan, cfg: GenerateConfig, result: Attempt, index: int) -
 def _render_videos(result: Attempt, states: np.ndarray, cfg: GenerateConfig) -> dict[str, np.ndarray]:
     world = result.world
     assert world is not None
-    width, height = cfg.size
-    out = {camera_key(c): np.empty((len(states), height, width, 3), np.uint8) for c in cfg.cameras}
+    width, height = cfg.render.size
+    cameras = cfg.render.cameras
+    out = {camera_key(c): np.empty((len(states), height, width, 3), np.uint8) for c in cameras}
     with Renderer(world, width, height) as renderer:
         for i, state in enumerate(states):
             world.set_state(state)
-            for cam in cfg.cameras:
+            for cam in cameras:
                 out[camera_key(cam)][i] = renderer.rgb(cam)
     return out

@@ -1,8 +1,8 @@
 """Instruction grounding: the ``Plan`` schema and the planners that produce it.
 
-``make_planner("offline")`` needs no network; ``make_planner("llm", backend_config)`` talks to any
-OpenAI-compatible endpoint (configured from ``VCAGE_LLM_*`` environment variables when no config
-is given).
+``make_planner(PlannerConfig("offline"))`` needs no network; ``PlannerConfig("llm", backend)``
+talks to any OpenAI-compatible endpoint or Gemini (from the ``VCAGE_LLM_*`` environment variables
+when the config names no backend).
 """
 
 from __future__ import annotations
@@ -11,10 +11,13 @@ from collections.abc import Callable
 from typing import Protocol
 
 from vcage.backends import BackendConfig, connect
+from vcage.planning.config import PlannerConfig
 from vcage.planning.llm import LLMPlanner
 from vcage.planning.offline import OfflinePlanner
 from vcage.planning.schema import Plan
 from vcage.registry import Registry
+
+LLM_ENV_PREFIX = "VCAGE_LLM"  # where the endpoint is read from when the config names none
 
 
 class Planner(Protocol):
@@ -23,14 +26,16 @@ class Planner(Protocol):
     def plan(self, instruction: str) -> Plan: ...
 
 
-PlannerFactory = Callable[[BackendConfig | None], Planner]
+PlannerFactory = Callable[[PlannerConfig], Planner]
 PLANNERS: Registry[PlannerFactory] = Registry("planner")
 PLANNERS.add("offline", lambda cfg: OfflinePlanner())
-PLANNERS.add("llm", lambda cfg: LLMPlanner(connect(cfg or BackendConfig.from_env())))
+PLANNERS.add("llm", lambda cfg: LLMPlanner(connect(cfg.backend or BackendConfig.from_env(LLM_ENV_PREFIX))))
 
 
-def make_planner(name: str = "offline", backend: BackendConfig | None = None) -> Planner:
-    return PLANNERS.get(name)(backend)
+def make_planner(config: PlannerConfig | str = "offline") -> Planner:
+    """The planner ``config`` names (a bare name: its default config)."""
+    cfg = PlannerConfig(config) if isinstance(config, str) else config
+    return PLANNERS.get(cfg.name)(cfg)
 
 
-__all__ = ["PLANNERS", "LLMPlanner", "OfflinePlanner", "Plan", "Planner", "make_planner"]
+__all__ = ["PLANNERS", "LLMPlanner", "OfflinePlanner", "Plan", "Planner", "PlannerConfig", "make_planner"]

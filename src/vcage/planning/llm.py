@@ -7,7 +7,6 @@ back with the validation errors, a bounded number of times, then :class:`Plannin
 
 from __future__ import annotations
 
-import inspect
 import json
 import re
 
@@ -17,22 +16,14 @@ from vcage.assets.catalog import CATALOG
 from vcage.backends import ChatBackend, Message
 from vcage.errors import PlanningError
 from vcage.planning.goals import GOALS
-from vcage.planning.schema import PLAN_SKILLS, PREDICATES, Plan
-from vcage.skills.primitives import SKILLS
+from vcage.planning.schema import Plan
+from vcage.vocabulary import PLAN_SKILLS, PREDICATES
 
 MAX_REPAIRS = 2
 
 
 def skill_library() -> str:
-    lines = []
-    for name in PLAN_SKILLS:
-        fn = SKILLS.get(name)
-        params = [p for p in inspect.signature(fn).parameters.values() if p.name != "s"]
-        sig = ", ".join(p.name if p.default is inspect.Parameter.empty else f"{p.name}={p.default!r}"
-                        for p in params)
-        doc = (inspect.getdoc(fn) or "").split("\n")[0]
-        lines.append(f"- {name}({sig}): {doc}")
-    return "\n".join(lines)
+    return "\n".join(f"- {s.name}({s.signature()}): {s.doc}" for s in PLAN_SKILLS.values())
 
 
 def catalog_lines() -> str:
@@ -47,7 +38,8 @@ def catalog_lines() -> str:
 
 def system_prompt() -> str:
     example = GOALS[0].plan(GOALS[0].phrasings[0]).model_dump(mode="json", exclude_none=True)
-    preds = ", ".join(f"{n}({lo}..{hi} objects)" for n, (lo, hi) in PREDICATES.items())
+    preds = "\n".join(f"- {p.name} ({p.arity[0]}..{p.arity[1]} objects): {p.meaning}"
+                       for p in PREDICATES.values())
     return (
         "You plan tabletop manipulation for a Franka Panda arm. Turn the user's instruction into a "
         "JSON plan: the objects the scene needs (catalog types only, each with a unique name; `on` "
@@ -55,8 +47,7 @@ def system_prompt() -> str:
         "an ordered list of 1 to 6 subtasks. Each subtask calls one skill with arguments that name "
         "plan objects, says in one sentence what must be visibly true afterwards, and lists the "
         "predicates that define its success.\n\n"
-        f"Skills:\n{skill_library()}\n\nPredicates: {preds}. 'released(x)': the hand no longer holds "
-        "x; 'pressed(x)': x's button or lever was pressed during the subtask.\n\n"
+        f"Skills:\n{skill_library()}\n\nPredicates:\n{preds}\n\n"
         f"Catalog:\n{catalog_lines()}\n\n"
         f"JSON schema of the reply:\n{json.dumps(Plan.model_json_schema(), separators=(',', ':'))}\n\n"
         f"Example for '{example['instruction']}':\n{json.dumps(example, separators=(',', ':'))}\n\n"

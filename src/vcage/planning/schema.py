@@ -8,24 +8,12 @@ predicates that define its success (what the oracle checks).
 
 from __future__ import annotations
 
-import inspect
 from typing import Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
 from vcage.assets.catalog import CATALOG
-from vcage.skills.primitives import SKILLS
-
-# predicate name -> (minimum, maximum) number of object arguments
-PREDICATES: dict[str, tuple[int, int]] = {
-    "on": (2, 2), "inside": (2, 2), "stacked": (2, 4), "near": (2, 2), "left_of": (2, 2),
-    "right_of": (2, 2), "on_table": (1, 1), "upright": (1, 1), "lifted": (1, 1),
-    "released": (1, 1), "pressed": (1, 1),
-}
-# skill arguments that name objects of the plan
-OBJECT_ARGS = ("obj", "target")
-# skills a plan may use (the composite ones a planner needs; the rest are building blocks)
-PLAN_SKILLS = ("pick_and_place", "press", "push", "lift", "grasp", "retreat", "open_gripper")
+from vcage.vocabulary import PLAN_SKILLS, PREDICATES
 
 
 class _Strict(BaseModel):
@@ -69,9 +57,7 @@ class Predicate(_Strict):
     def _arity(self) -> Predicate:
         if self.name not in PREDICATES:
             raise ValueError(f"unknown predicate {self.name!r}; valid: {', '.join(PREDICATES)}")
-        lo, hi = PREDICATES[self.name]
-        if not lo <= len(self.args) <= hi:
-            raise ValueError(f"predicate {self.name} takes {lo}..{hi} objects, got {list(self.args)}")
+        PREDICATES.get(self.name).check_arity(self.args)
         return self
 
     def __str__(self) -> str:
@@ -88,19 +74,11 @@ class Subtask(_Strict):
     def _skill_signature(self) -> Subtask:
         if self.skill not in PLAN_SKILLS:
             raise ValueError(f"unknown skill {self.skill!r}; valid: {', '.join(PLAN_SKILLS)}")
-        params = inspect.signature(SKILLS.get(self.skill)).parameters
-        names = [p for p in params if p != "s"]
-        extra = set(self.args) - set(names)
-        if extra:
-            raise ValueError(f"skill {self.skill} has no argument(s) {sorted(extra)}; it takes {names}")
-        missing = [p for p, v in params.items() if p != "s" and v.default is inspect.Parameter.empty
-                   and p not in self.args]
-        if missing:
-            raise ValueError(f"skill {self.skill} needs argument(s) {missing}")
+        PLAN_SKILLS.get(self.skill).check_args(self.args)
         return self
 
     def objects(self) -> list[str]:
-        named = [self.args[k] for k in OBJECT_ARGS if isinstance(self.args.get(k), str)]
+        named = PLAN_SKILLS.get(self.skill).object_args(self.args)
         return named + [a for p in self.predicates for a in p.args]
 
 

@@ -14,7 +14,7 @@ import numpy as np
 
 from vcage.assets.catalog import CATALOG, ObjectType
 from vcage.assets.parts import PartBuilder
-from vcage.config import SimConfig
+from vcage.config import OFFSCREEN_SIZE, SimConfig
 from vcage.geometry import look_at_quat, yaw_quat
 from vcage.scene.spec import ROBOT_MOUNT, SceneSpec, TableSpec
 from vcage.sim.robot import GRIPPER_OPEN, HOME_QPOS, Robot, attach_panda
@@ -28,7 +28,6 @@ CAMERAS = {
 }
 TOP_CAMERA = "top"
 TOP_CAMERA_HEIGHT = 1.5  # above the table top
-OFFSCREEN_SIZE = (640, 480)
 ARENA_BASE = 32 * 2**20  # bytes of MuJoCo arena (contacts, constraints) per scene ...
 ARENA_PER_OBJECT = 4 * 2**20  # ... plus this per object
 

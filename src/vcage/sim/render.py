@@ -9,6 +9,7 @@ them as context managers.
 from __future__ import annotations
 
 import contextlib
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import mujoco
@@ -70,6 +71,16 @@ class Renderer:
             r.disable_depth_rendering()
         return depth.astype(np.float32)
 
+    def pixel_size(self, camera: str) -> float | None:
+        """Metres per pixel of an orthographic camera (its ``fovy`` is the view's height in
+        metres); None for a perspective camera, whose scale varies with depth."""
+        self._check(camera)
+        model = self.world.model
+        cid = model.camera(camera).id
+        if int(model.cam_projection[cid]) != int(mujoco.mjtProjection.mjPROJ_ORTHOGRAPHIC):
+            return None
+        return float(model.cam_fovy[cid]) / self.height
+
     def segmentation(self, camera: str) -> np.ndarray:
         """Per-pixel object index into ``world.object_names``; :data:`ROBOT` for the robot, else -1."""
         r = self._check(camera)
@@ -109,3 +120,32 @@ class Renderer:
     def __del__(self) -> None:  # a safety net only; callers close explicitly
         with contextlib.suppress(Exception):  # interpreter shutdown may have torn GL down
             self.close()
+
+
+def contact_sheet(world: World, states: Sequence[np.ndarray | None], cameras: Sequence[str],
+                  width: int = 320, height: int = 240) -> np.ndarray:
+    """One RGB image of ``world`` seen from ``cameras`` at each of ``states``.
+
+    Row ``i`` is ``states[i]`` and column ``j`` is ``cameras[j]``, each view ``width`` x
+    ``height``: the result is ``(len(states) * height, len(cameras) * width, 3)`` uint8. A state
+    of ``None`` is the world as it stands, rendered before any other state is set and without
+    recomputing its derived quantities (after a step, body poses lag the integration state by
+    that step, which re-setting the state would change). The world's state is restored after.
+    """
+    if not states or not cameras:
+        raise ConfigError("a contact sheet needs at least one state and one camera")
+    rows: list[list[np.ndarray]] = [[] for _ in states]
+    with Renderer(world, width, height) as renderer:
+        for i, state in enumerate(states):
+            if state is None:
+                rows[i] = [renderer.rgb(c) for c in cameras]
+        if any(state is not None for state in states):
+            current = world.get_state()
+            try:
+                for i, state in enumerate(states):
+                    if state is not None:
+                        world.set_state(state)
+                        rows[i] = [renderer.rgb(c) for c in cameras]
+            finally:
+                world.set_state(current)
+    return np.concatenate([np.concatenate(row, 1) for row in rows], 0)

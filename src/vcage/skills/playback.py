@@ -1,6 +1,6 @@
-"""Runs motion plans on a :class:`World` with position control at the control rate, recording.
+"""Plays motion plans back on a :class:`World` with position control at the control rate, recording.
 
-Per control step the executor records joint positions, gripper width, the TCP pose, and the
+Per control step the player records joint positions, gripper width, the TCP pose, and the
 commanded action (7 arm joint targets and the gripper command), which is what a dataset stores.
 """
 
@@ -13,7 +13,7 @@ import numpy as np
 
 from vcage.geometry import mat_to_quat
 from vcage.sim.world import World
-from vcage.skills.plan import MotionPlan, min_jerk
+from vcage.skills.motion import MotionPlan, min_jerk
 
 StepHook = Callable[[World], None]
 
@@ -42,7 +42,7 @@ class Recording:
         }
 
 
-class Executor:
+class Player:
     """Interpolates waypoints with minimum-jerk timing and steps the world once per control tick."""
 
     def __init__(self, world: World, record: bool = True, record_states: bool = False) -> None:

@@ -23,9 +23,9 @@ from vcage.registry import Registry
 from vcage.scene.spec import ROBOT_MOUNT
 from vcage.sim.robot import HOME_QPOS
 from vcage.sim.world import World
-from vcage.skills.executor import Executor
 from vcage.skills.ik import IKSolver, down_rotation
-from vcage.skills.plan import MotionPlan, Waypoint
+from vcage.skills.motion import MotionPlan, Waypoint
+from vcage.skills.playback import Player
 
 SKILLS: Registry[Callable[..., MotionPlan]] = Registry("skill")
 
@@ -48,24 +48,24 @@ class GraspChoice:
 
 
 class Skills:
-    """Plans primitives on a world and executes them with one :class:`Executor`."""
+    """Plans primitives on a world and executes them with one :class:`Player`."""
 
-    def __init__(self, world: World, executor: Executor | None = None) -> None:
+    def __init__(self, world: World, player: Player | None = None) -> None:
         self.world = world
         self.ik = IKSolver(ROBOT_MOUNT)
-        self.executor = executor or Executor(world)
+        self.player = player or Player(world)
         self.table_z = world.table_top()
         self._cursor: tuple[np.ndarray, float] | None = None
 
     # -- state of the plan being built ---------------------------------------------------------
     @property
     def q(self) -> np.ndarray:
-        """Arm command the next plan starts from (the executor's, or the end of a plan being chained)."""
-        return (self._cursor[0] if self._cursor else self.executor.q_cmd).copy()
+        """Arm command the next plan starts from (the player's, or the end of a plan being chained)."""
+        return (self._cursor[0] if self._cursor else self.player.q_cmd).copy()
 
     @property
     def gripper(self) -> float:
-        return self._cursor[1] if self._cursor else self.executor.gripper_cmd
+        return self._cursor[1] if self._cursor else self.player.gripper_cmd
 
     @contextmanager
     def after(self, plan: MotionPlan) -> Iterator[None]:
@@ -85,7 +85,7 @@ class Skills:
     def do(self, name: str, **kwargs: object) -> MotionPlan:
         """Plan skill ``name`` from the current state and execute it."""
         plan = SKILLS.get(name)(self, **kwargs)
-        self.executor.run(plan)
+        self.player.run(plan)
         return plan
 
     # -- building blocks ----------------------------------------------------------------------

@@ -1,6 +1,11 @@
-"""Atomic tasks: scene, scripted expert and success evaluation, one file per task."""
+"""Atomic tasks: scene layout, scripted expert and success in the predicate vocabulary.
 
-from vcage.tasks.base import TASKS, AtomicTask, Item
-from vcage.tasks.runner import EpisodeResult, run_episode
+Importing the package registers the built-in tasks (:mod:`vcage.tasks.library`) in ``TASKS``.
+"""
 
-__all__ = ["TASKS", "AtomicTask", "EpisodeResult", "Item", "run_episode"]
+from vcage.tasks import library  # noqa: F401  (registers the built-in tasks)
+from vcage.tasks.base import TASKS, AtomicTask, Item, pred
+from vcage.tasks.runner import EpisodeResult, make_task, place_scene, prepare, run_episode
+
+__all__ = ["TASKS", "AtomicTask", "EpisodeResult", "Item", "make_task", "place_scene", "pred",
+           "prepare", "run_episode"]

@@ -1,7 +1,12 @@
-"""The atomic task interface: ``build`` a scene, run an ``expert``, ``evaluate`` success.
+"""The atomic task interface: a scene ``layout``, an ``expert``, and success in the vocabulary.
 
 A task instance lives for one episode, so it may remember what it sampled (colours, targets) and
-what it observed (initial poses, latched presses) between ``build``, ``setup`` and ``evaluate``.
+what it observed between :meth:`AtomicTask.layout_spec`, :meth:`AtomicTask.setup` and
+:meth:`AtomicTask.evaluate`. Success is declared as predicates of :mod:`vcage.vocabulary` in
+:meth:`AtomicTask.success` and judged by the same oracle that audits every subtask of a plan;
+a task whose success needs other measures (a distance, a row) overrides :meth:`evaluate`.
+
+A new task is one module in :mod:`vcage.tasks.library` that registers its class in ``TASKS``.
 """
 
 from __future__ import annotations
@@ -12,16 +17,22 @@ from typing import Any, ClassVar
 import numpy as np
 
 from vcage.config import Randomization
+from vcage.planning.schema import Predicate
 from vcage.registry import Registry
-from vcage.scene.layout import Relation, ReservedZone
-from vcage.scene.placement import PlacementStats, place
+from vcage.scene.layout import LayoutSpec, Relation, ReservedZone
 from vcage.scene.spec import SceneSpec
 from vcage.sim.world import World
 from vcage.skills.primitives import Skills
-from vcage.skills.reach import reach_map
-from vcage.tasks.layout import Item, SceneConfig, task_layout
+from vcage.tasks.items import Item, task_layout
+from vcage.tasks.oracle import Oracle
+from vcage.tasks.success import HOLD_STEPS
 
-__all__ = ["TASKS", "AtomicTask", "Item", "Latch", "SceneConfig"]
+__all__ = ["TASKS", "AtomicTask", "Item", "pred"]
+
+
+def pred(name: str, *args: str) -> Predicate:
+    """A predicate of the vocabulary, e.g. ``pred("on", "mouse", "pad")``."""
+    return Predicate(name=name, args=args)
 
 
 class AtomicTask(ABC):
@@ -32,40 +43,47 @@ class AtomicTask(ABC):
     items: ClassVar[tuple[Item, ...]] = ()
     relations: ClassVar[tuple[Relation, ...]] = ()  # between items, kept when randomised
     reserved: ClassVar[tuple[ReservedZone, ...]] = ()  # table regions the expert will use
-    hold_steps: ClassVar[int] = 5  # success must hold this many consecutive control steps
+    hold_steps: ClassVar[int] = HOLD_STEPS  # success must hold this many consecutive control steps
 
     def __init__(self) -> None:
         self.spec: SceneSpec | None = None
-        self.placement_stats: PlacementStats | None = None
+        self.oracle = Oracle()
 
     # -- scene -----------------------------------------------------------------------------
     def layout(self, rng: np.random.Generator) -> tuple[Item, ...]:
         """The nominal items of this episode (override to sample e.g. which object goes where)."""
         return self.items
 
-    def build(self, rng: np.random.Generator, rand: Randomization,
-              scene: SceneConfig | None = None) -> SceneSpec:
-        """Lay out this episode's items and place them (context-aware unless ``scene`` says)."""
-        scene = scene or SceneConfig()
-        layout = task_layout(self.layout(rng), rng, rand, self.relations, self.reserved, scene.clutter)
-        result = place(layout, rng, scene.placement, scene.config, reach_map())
-        self.spec, self.placement_stats = result.scene, result.stats
-        return self.spec
+    def layout_spec(self, rng: np.random.Generator, rand: Randomization, clutter: int = 0) -> LayoutSpec:
+        """This episode's layout: its items randomised by ``rand``, with ``clutter`` distractors."""
+        return task_layout(self.layout(rng), rng, rand, self.relations, self.reserved, clutter)
 
     def setup(self, world: World) -> None:
-        """Called once the scene has settled, before the expert runs."""
+        """Called once the scene has settled, before the expert runs: the oracle starts watching
+        (events such as a press are latched from here on). Overrides call ``super().setup``."""
+        self.oracle.begin(self.success())
 
     def on_step(self, world: World) -> None:
-        """Called after every control step (for latched events such as a press)."""
+        """Called after every control step."""
+        self.oracle.on_step(world)
 
     # -- behaviour ---------------------------------------------------------------------------
     @abstractmethod
     def expert(self, skills: Skills) -> None:
         """Scripted expert: a sequence of skill calls."""
 
-    @abstractmethod
+    def success(self) -> tuple[Predicate, ...]:
+        """The predicates that must all hold for the task to succeed."""
+        return ()
+
     def evaluate(self, world: World) -> dict[str, Any]:
-        """Predicates on the current state; must contain a boolean ``"success"``."""
+        """Each success predicate's value now, and ``"success"``: whether all hold."""
+        preds = self.success()
+        if not preds:
+            raise NotImplementedError(f"{type(self).__name__} declares no success predicates; "
+                                      "override success() or evaluate()")
+        values = self.oracle.check(world, preds)
+        return {"success": all(values.values()), **values}
 
     # -- language ----------------------------------------------------------------------------
     def words(self) -> dict[str, str]:
@@ -77,22 +95,8 @@ class AtomicTask(ABC):
         return self.instructions[idx].format(**self.words())
 
     def color_of(self, obj: str) -> str:
-        assert self.spec is not None, "build() first"
+        assert self.spec is not None, "instantiate the scene first"
         return self.spec.object(obj).color or ""
-
-
-class Latch:
-    """Becomes true once a condition held for ``steps`` consecutive control steps, and stays true."""
-
-    def __init__(self, steps: int = 3) -> None:
-        self.steps = steps
-        self.count = 0
-        self.value = False
-
-    def update(self, condition: bool) -> bool:
-        self.count = self.count + 1 if condition else 0
-        self.value = self.value or self.count >= self.steps
-        return self.value
 
 
 TASKS: Registry[type[AtomicTask]] = Registry("task")

@@ -1,15 +1,19 @@
 """Ground-truth predicates: pure functions of the simulator state of a :class:`World`.
 
 They read positions, orientations, contacts and joint values; they never change the world. The
-image critic must not use them; the oracle and the task ``evaluate`` methods do.
+image critic must not use them; the oracle and the task ``evaluate`` methods do. ``ORACLE_CHECKS``
+maps every predicate of :mod:`vcage.vocabulary` to its check with the default parameters.
 """
 
 from __future__ import annotations
+
+from collections.abc import Callable
 
 import numpy as np
 
 from vcage.assets.catalog import CATALOG
 from vcage.geometry import tilt_of
+from vcage.registry import Registry
 from vcage.sim.world import World
 
 XY_TOL = 0.01  # slack beyond a placement region's edge
@@ -135,3 +139,19 @@ def pressed(world: World, obj: str, point: str | None = None) -> bool:
 def moved(world: World, obj: str, start_xy: np.ndarray, distance: float) -> bool:
     return bool(np.linalg.norm(world.object_pos(obj)[:2] - np.asarray(start_xy)[:2]) >= distance)
 
+
+
+# -- the oracle's check of each predicate of the vocabulary, with the default parameters ----------
+
+ORACLE_CHECKS: Registry[Callable[..., bool]] = Registry("oracle check")
+ORACLE_CHECKS.add("on", lambda w, a, b: on(w, a, b))
+ORACLE_CHECKS.add("inside", lambda w, a, b: inside(w, a, b))
+ORACLE_CHECKS.add("stacked", lambda w, *objs: stacked(w, list(objs)))
+ORACLE_CHECKS.add("near", lambda w, a, b: near(w, a, b))
+ORACLE_CHECKS.add("left_of", lambda w, a, b: left_of(w, a, b))
+ORACLE_CHECKS.add("right_of", lambda w, a, b: right_of(w, a, b))
+ORACLE_CHECKS.add("on_table", lambda w, a: on_table(w, a, tol=0.02))
+ORACLE_CHECKS.add("upright", lambda w, a: upright(w, a))
+ORACLE_CHECKS.add("lifted", lambda w, a: lifted(w, a))
+ORACLE_CHECKS.add("released", lambda w, a: not grasped(w, a))
+ORACLE_CHECKS.add("pressed", lambda w, a: pressed(w, a))  # an event: the oracle latches it

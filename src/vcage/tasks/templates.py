@@ -5,20 +5,18 @@ Concrete tasks subclass these and only declare their objects, words and instruct
 
 from __future__ import annotations
 
-from typing import Any, ClassVar
+from typing import ClassVar
 
-from vcage.sim.world import World
+from vcage.planning.schema import Predicate
 from vcage.skills.primitives import Skills
-from vcage.tasks import predicates as P
-from vcage.tasks.base import AtomicTask, Latch
+from vcage.tasks.base import AtomicTask, pred
 
 
 class PlaceTask(AtomicTask):
-    """Pick ``obj`` and put it on (or in) ``target``'s placement annotation."""
+    """Pick ``obj`` and put it on (or in) ``target``'s placement surface, and let go."""
 
     obj: ClassVar[str]
     target: ClassVar[str]
-    placement: ClassVar[str | None] = None
     relation: ClassVar[str] = "on"  # "on" | "inside"
     need_upright: ClassVar[bool] = False
 
@@ -29,37 +27,23 @@ class PlaceTask(AtomicTask):
                 "obj_color": self.color_of(self.obj), "target_color": self.color_of(self.target)}
 
     def expert(self, skills: Skills) -> None:
-        skills.do("pick_and_place", obj=self.obj, target=self.target, placement=self.placement)
+        skills.do("pick_and_place", obj=self.obj, target=self.target)
         skills.do("retreat")
 
-    def evaluate(self, world: World) -> dict[str, Any]:
-        check = P.inside if self.relation == "inside" else P.on
-        placed = check(world, self.obj, self.target, self.placement)
-        released = not P.grasped(world, self.obj)
-        upright = P.upright(world, self.obj) if self.need_upright else True
-        return {"success": placed and released and upright, self.relation: placed,
-                "released": released, "upright": upright}
+    def success(self) -> tuple[Predicate, ...]:
+        upright = (pred("upright", self.obj),) if self.need_upright else ()
+        return (pred(self.relation, self.obj, self.target), pred("released", self.obj), *upright)
 
 
 class PressTask(AtomicTask):
-    """Press ``obj``'s functional point ``point``; success is latched once it was held pressed."""
+    """Press ``obj``'s (first) functional point; the press is latched once it was held."""
 
     obj: ClassVar[str]
-    point: ClassVar[str | None] = None
-    press_steps: ClassVar[int] = 2
-
-    def setup(self, world: World) -> None:
-        self.latch = Latch(self.press_steps)
-        self.start = world.object_pos(self.obj)
-
-    def on_step(self, world: World) -> None:
-        self.latch.update(P.pressed(world, self.obj, self.point))
+    point: ClassVar[str | None] = None  # the skill's target point; ``pressed`` watches the first
 
     def expert(self, skills: Skills) -> None:
         skills.do("press", obj=self.obj, point=self.point)
         skills.do("retreat")
 
-    def evaluate(self, world: World) -> dict[str, Any]:
-        upright = P.upright(world, self.obj)
-        return {"success": self.latch.value and upright, "pressed": self.latch.value,
-                "upright": upright}
+    def success(self) -> tuple[Predicate, ...]:
+        return (pred("pressed", self.obj), pred("upright", self.obj))

@@ -3,7 +3,7 @@
 The Panda's first joint turns the whole arm about the base's vertical axis, so top-down
 reachability depends only on the horizontal distance ``r`` from the base axis and the height
 ``z`` above the base. A :class:`ReachMap` stores, per height, the interval of ``r`` in which IK
-found a top-down configuration. It is computed by :mod:`vcage.skills.reach` (which owns IK) once
+found a top-down configuration. It is computed by :mod:`vcage.skills.reachability` (which owns IK) once
 per robot and cached on disk; this module only reads it.
 """
 

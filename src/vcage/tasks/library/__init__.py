@@ -1,22 +1,11 @@
-"""The built-in atomic tasks, one module each; importing registers them in ``TASKS``."""
+"""The built-in atomic tasks, one module each, named after the task it registers in ``TASKS``.
 
-from vcage.tasks.library import (  # noqa: F401
-    blocks_ranking_rgb,
-    click_alarmclock,
-    click_bell,
-    lift_pot,
-    move_can_pot,
-    place_a2b_left,
-    place_a2b_right,
-    place_bread_basket,
-    place_empty_cup,
-    place_mouse_pad,
-    place_object_stand,
-    place_phone_stand,
-    press_stapler,
-    stack_blocks_three,
-    stack_blocks_two,
-    stack_bowls_two,
-    stamp_seal,
-    turn_switch,
-)
+Every module of this package is imported when the package is, so a new task is one new file here.
+"""
+
+import importlib
+import pkgutil
+
+MODULES = tuple(sorted(m.name for m in pkgutil.iter_modules(__path__) if not m.name.startswith("_")))
+for _module in MODULES:
+    importlib.import_module(f"{__name__}.{_module}")

@@ -2,12 +2,9 @@
 
 from __future__ import annotations
 
-from typing import Any
-
-from vcage.sim.world import World
+from vcage.planning.schema import Predicate
 from vcage.skills.primitives import Skills
-from vcage.tasks import predicates as P
-from vcage.tasks.base import TASKS, AtomicTask, Item
+from vcage.tasks.base import TASKS, AtomicTask, Item, pred
 
 
 @TASKS.register("stack_blocks_three")
@@ -31,7 +28,5 @@ class StackBlocksThree(AtomicTask):
         skills.do("pick_and_place", obj="block_c", target="block_a")
         skills.do("retreat")
 
-    def evaluate(self, world: World) -> dict[str, Any]:
-        stacked = P.stacked(world, ["block_b", "block_a", "block_c"])
-        released = not P.grasped(world, "block_c")
-        return {"success": stacked and released, "stacked": stacked, "released": released}
+    def success(self) -> tuple[Predicate, ...]:
+        return pred("stacked", "block_b", "block_a", "block_c"), pred("released", "block_c")

@@ -21,7 +21,7 @@ from vcage.scene.layout import (
     ReservedZone,
     Support,
 )
-from vcage.tasks.layout import environment, object_look
+from vcage.scene.randomize import environment, object_look
 
 # x 0.45..0.70, y -0.3..0.3 (metres): reachable for every skill, and clear of the arm's home pose
 # in the top view, so that the critic sees the objects after each subtask

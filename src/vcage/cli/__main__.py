@@ -1,0 +1,5 @@
+"""``python -m vcage.cli``."""
+
+from vcage.cli import main
+
+main()

@@ -1,0 +1,143 @@
+"""``vcage generate``: a verified dataset for an instruction, and the funnel of its attempts."""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Callable
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import typer
+from rich.table import Table
+
+from vcage.cli._app import app, console
+from vcage.cli.errors import cli_errors
+from vcage.errors import ConfigError
+
+if TYPE_CHECKING:
+    from vcage.pipeline.config import GenerateConfig
+
+
+@app.command("generate")
+@cli_errors
+def generate_cmd(
+        instruction: str = typer.Argument(..., help="e.g. 'get ready for work'"),
+        episodes: int = typer.Option(3, min=1, help="accepted episodes to produce"),
+        out: Path = typer.Option(Path("out/dataset"), help="dataset directory (LeRobot v3 layout)"),
+        config: Path = typer.Option(None, help="a JSON configuration tree to start from (e.g. the "
+                                    "\"generate\" part of a dataset's meta/vcage.json); options "
+                                    "given here override it"),
+        mode: str = typer.Option("vcage", help="preset: vcage, or vanilla (naive placement, no "
+                                 "scene check, no critic)"),
+        planner: str = typer.Option(None, help="offline (default) or llm"),
+        planner_model: str = typer.Option(None, help="LLM planner's model (else $VCAGE_LLM_MODEL)"),
+        planner_url: str = typer.Option(None, help="LLM planner's base URL (else $VCAGE_LLM_BASE_URL)"),
+        planner_provider: str = typer.Option(None, help="openai (any compatible server) or gemini"),
+        critic: str = typer.Option(None, help="critic that verifies each subtask: image (default, "
+                                   "offline), vlm, oracle"),
+        critic_model: str = typer.Option(None, help="VLM critic's model (else $VCAGE_VLM_MODEL)"),
+        critic_url: str = typer.Option(None, help="VLM critic's base URL (else $VCAGE_VLM_BASE_URL)"),
+        critic_provider: str = typer.Option(None, help="openai (any compatible server) or gemini"),
+        votes: int = typer.Option(None, help="VLM critic: answers asked per subtask (default 1)"),
+        vote_rule: str = typer.Option(None, help="VLM critic: majority (default) or all"),
+        placement: str = typer.Option(None, help="context (default), naive or rejection"),
+        clutter: int = typer.Option(None, help="distractors per scene (default 4)"),
+        seed: int = typer.Option(None, help="run seed (default 0)"),
+        max_attempts: int = typer.Option(None, help="attempts per episode (default 10)"),
+        cameras: str = typer.Option(None, help="comma-separated cameras to record (default "
+                                    "front,panda/wrist)"),
+        size: int = typer.Option(None, help="video width and height (even; default 128)"),
+        workers: int = typer.Option(None, help="episodes attempted at once (one core each); the "
+                                    "dataset is the same for any number"),
+        executor: str = typer.Option(None, help="local (this machine: processes) or ray"),
+        address: str = typer.Option(None, help="with --executor ray: a running cluster's address "
+                                    "(e.g. auto); default: start Ray locally")) -> None:
+    """Generate a verified dataset for INSTRUCTION; prints the funnel and writes stats.json."""
+    from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
+
+    from vcage.pipeline.generate import generate
+
+    cfg = build_config(config, mode, {
+        ("planner", "name"): planner, ("critic", "name"): critic, ("critic", "votes"): votes,
+        ("critic", "rule"): vote_rule, ("scene", "placement"): placement, ("scene", "clutter"): clutter,
+        ("seed",): seed, ("max_attempts",): max_attempts,
+        ("render", "cameras"): tuple(c.strip() for c in cameras.split(",") if c.strip()) if cameras else None,
+        ("render", "size"): (size, size) if size is not None else None,
+        ("executor", "name"): executor, ("executor", "workers"): workers, ("executor", "address"): address,
+    }, {"planner": ("VCAGE_LLM", planner_provider, planner_url, planner_model),
+        "critic": ("VCAGE_VLM", critic_provider, critic_url, critic_model)})
+    with Progress(TextColumn("{task.description}"), BarColumn(),
+                  TextColumn("{task.completed}/{task.total}"), TimeElapsedColumn(),
+                  console=console) as bar:
+        job = bar.add_task("episodes", total=episodes)
+
+        def update(f: object) -> None:
+            from vcage.pipeline.generate import Funnel
+
+            assert isinstance(f, Funnel)
+            bar.update(job, completed=f.accepted + f.given_up,
+                       description=f"episodes (attempts {f.attempts}, accepted {f.accepted})")
+
+        funnel = generate(instruction, episodes, out, cfg, progress=update)
+    _print_funnel(funnel.to_dict(), out)
+
+
+def build_config(path: Path | None, mode: str, options: dict[tuple[str, ...], Any],
+                 backends: dict[str, tuple[str, str | None, str | None, str | None]]) -> GenerateConfig:
+    """The run's configuration tree: a file or a preset, then every option given on the command line.
+
+    ``options`` maps a field's path in the tree to its value (None: not given); ``backends`` maps
+    ``planner``/``critic`` to (environment prefix, provider, base URL, model) given for its endpoint.
+    """
+    from vcage.backends import BackendConfig
+    from vcage.pipeline.config import GenerateConfig
+
+    presets: dict[str, Callable[[], GenerateConfig]] = {"vcage": GenerateConfig,
+                                                         "vanilla": GenerateConfig.vanilla}
+    if mode not in presets:
+        raise ConfigError(f"unknown mode {mode!r}; valid: {', '.join(presets)}")
+    if path is not None:
+        try:
+            data = json.loads(path.read_text())
+        except (OSError, json.JSONDecodeError) as exc:
+            raise ConfigError(f"cannot read the configuration {path}: {exc}") from None
+        cfg = GenerateConfig.from_dict(data.get("config", {}).get("generate", data))
+    else:
+        cfg = presets[mode]()
+    tree = cfg.to_dict()
+    for keys, value in options.items():
+        if value is not None:
+            node = tree
+            for key in keys[:-1]:
+                if node.get(key) is None:  # e.g. a critic named on top of the Vanilla preset
+                    node[key] = {}
+                node = node[key]
+            node[keys[-1]] = value
+    for part, (prefix, provider, url, model) in backends.items():
+        given = {k: v for k, v in (("provider", provider), ("base_url", url), ("model", model)) if v}
+        if given:
+            if tree.get(part) is None:
+                raise ConfigError(f"--{part}-* options need a {part} (Vanilla runs have no critic)")
+            tree[part]["backend"] = BackendConfig.from_env(prefix, None, **given).to_dict()
+    return GenerateConfig.from_dict(tree)
+
+
+def _print_funnel(stats: dict, out: Path) -> None:
+    table = Table("stage", "attempts")
+    for stage, n in sorted(stats["stages"].items(), key=lambda kv: -kv[1]):
+        table.add_row(stage, str(n))
+    console.print(table)
+    if stats["rejections_by_reason"]:
+        reasons = Table("rejected at: reason", "attempts")
+        for reason, n in stats["rejections_by_reason"].items():
+            reasons.add_row(reason, str(n))
+        console.print(reasons)
+    ratio = stats["total_over_physics_and_render"]
+    timing = f"; total / (physics + render) = {ratio:.2f}" if ratio else ""
+    console.print(
+        f"accepted {stats['accepted']}/{stats['episodes_requested']} episodes in {stats['attempts']} "
+        f"attempts ({stats['given_up']} given up); label noise (oracle audit of accepted): "
+        f"{stats['label_noise']:.1%}; {stats['wall_seconds']:.1f} s wall, "
+        f"{stats['episodes_per_hour']:.0f} episodes/hour on {stats['workers']} worker(s) "
+        f"({stats['episodes_per_core_hour']:.0f} per core-hour){timing}")
+    console.print(f"dataset and stats.json in {out}/")

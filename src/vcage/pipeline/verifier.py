@@ -1,0 +1,84 @@
+"""The critic's side of a rollout: render the views it needs around each subtask and ask it.
+
+The critic sees rendered images, segmentation and depth, the subtask's description and
+predicates; the oracle's values ride along only for the oracle critic. The frame "during" a
+subtask is chosen from proprioception (where the hand was lowest, e.g. a press), as on a robot.
+"""
+
+from __future__ import annotations
+
+import time
+from typing import Any, Protocol
+
+import numpy as np
+
+from vcage.critics.base import Critic, Observation, View
+from vcage.planning.schema import Plan, Subtask
+from vcage.sim.render import Renderer
+from vcage.sim.world import World
+from vcage.skills.playback import Recording
+
+CRITIC_CAMERAS = ("top", "front")  # the views a critic gets: top-down (orthographic) and front
+DEPTH_CAMERAS = ("front",)  # ... with depth where the camera is perspective (RGB-D)
+
+
+class Outcome(Protocol):
+    """What the verifier needs of a finished subtask (see :class:`.rollout.SubtaskOutcome`)."""
+
+    index: int
+    start: int
+    end: int
+    oracle: dict[str, bool]
+
+
+class Timed(Protocol):
+    render: float
+
+
+def render_views(renderer: Renderer, cameras: tuple[str, ...] = CRITIC_CAMERAS,
+                 depth_cameras: tuple[str, ...] = DEPTH_CAMERAS) -> dict[str, View]:
+    """The critic's views of the world as it is now."""
+    return {cam: View(renderer.rgb(cam), renderer.segmentation(cam),
+                      renderer.depth(cam) if cam in depth_cameras else None, renderer.pixel_size(cam))
+            for cam in cameras}
+
+
+class Verifier:
+    """Asks ``critic`` about each subtask, with views rendered before, during and after it."""
+
+    def __init__(self, world: World, plan: Plan, critic: Critic, renderer: Renderer | None,
+                 recording: Recording, timing: Timed) -> None:
+        self.world, self.plan, self.critic = world, plan, critic
+        self.renderer, self.recording, self.timing = renderer, recording, timing
+        self._before: dict[str, View] = {}
+
+    def _views(self) -> dict[str, View]:
+        if self.renderer is None:
+            return {}
+        t0 = time.perf_counter()
+        views = render_views(self.renderer)
+        self.timing.render += time.perf_counter() - t0
+        return views
+
+    def start(self, index: int, subtask: Subtask) -> None:
+        self._before = self._views()
+
+    def judge(self, outcome: Outcome) -> dict[str, Any]:
+        obs = Observation(subtask=self.plan.subtasks[outcome.index], labels=tuple(self.world.object_names),
+                          before=self._before, after=self._views(), during=self._deepest(outcome),
+                          oracle=outcome.oracle)
+        return self.critic.judge(obs).to_dict()
+
+    def _deepest(self, outcome: Outcome) -> dict[str, View]:
+        """Views of the recorded frame where the hand was lowest during the subtask."""
+        rec = self.recording
+        if self.renderer is None or outcome.end <= outcome.start or not rec.states:
+            return {}
+        heights = [p[2] for p in rec.ee_pos[outcome.start:outcome.end]]
+        frame = outcome.start + int(np.argmin(heights))
+        now = self.world.get_state()
+        self.world.set_state(rec.states[frame])
+        try:
+            return self._views()
+        finally:
+            self.world.set_state(now)
