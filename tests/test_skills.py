@@ -6,8 +6,8 @@ import pytest
 from vcage.errors import IKError, RegistryError, SkillError, UnreachableError
 from vcage.sim.robot import HOME_QPOS
 from vcage.sim.world import World
+from vcage.skills.base import SKILLS, Skills
 from vcage.skills.ik import IKSolver, down_rotation
-from vcage.skills.primitives import SKILLS, Skills
 from vcage.tasks import predicates as P
 
 

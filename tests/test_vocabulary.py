@@ -9,7 +9,7 @@ from collections.abc import Callable
 import pytest
 
 from vcage.critics.image import IMAGE_CHECKS
-from vcage.skills.primitives import SKILLS
+from vcage.skills.base import SKILLS
 from vcage.tasks.predicates import ORACLE_CHECKS
 from vcage.vocabulary import PLAN_SKILLS, PREDICATES
 

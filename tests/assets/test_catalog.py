@@ -23,8 +23,8 @@ MAX_GRASP_WIDTH = 0.065
 PALM_ABOVE_TCP = 0.045  # the Panda's palm is ~47 mm above the grasp point (between the pads)
 PRESS_FORCE = 10.0  # N, pushed along the functional point's direction
 ALL = CATALOG.names()
-CONTAINERS = [o.name for o in CATALOG.all() if any(p.kind == "in" for p in o.placements)]
-PRESSABLE = [o.name for o in CATALOG.all() if any(f.joint for f in o.functional_points)]
+CONTAINERS = [o.name for o in CATALOG.values() if any(p.kind == "in" for p in o.placements)]
+PRESSABLE = [o.name for o in CATALOG.values() if any(f.joint for f in o.functional_points)]
 
 
 def _world(*objects: ObjectSpec) -> World:

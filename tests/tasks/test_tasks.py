@@ -9,8 +9,8 @@ from vcage.scene.instantiate import SceneConfig
 from vcage.scene.placement import PlacementStats
 from vcage.scene.spec import SceneSpec
 from vcage.sim.world import World
+from vcage.skills.base import Skills
 from vcage.skills.playback import Player
-from vcage.skills.primitives import Skills
 from vcage.tasks import TASKS, AtomicTask, make_task, place_scene, run_episode
 from vcage.tasks.success import held
 

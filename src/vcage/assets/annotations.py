@@ -5,9 +5,13 @@ The object frame has its origin at the centre of the object's resting face, z up
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 Vec3 = tuple[float, ...]  # (x, y, z)
+HALF_PI = math.pi / 2
+FOUR_SIDES = (0.0, HALF_PI, math.pi, -HALF_PI)  # angles of the four sides of a round object
+RIM_DROP = 0.015  # rim grasps hold the wall this far below its top
 
 
 @dataclass(frozen=True)
@@ -24,6 +28,22 @@ class Grasp:
     yaw: float = 0.0
     width: float = 0.04
     tilt: float = 0.0
+
+
+def grasp_pair(name: str, pos: Vec3, width: float, yaw: float = 0.0,
+               second: float = HALF_PI) -> tuple[Grasp, Grasp]:
+    """Two top-down grasps at ``pos``: ``name`` at ``yaw`` and ``name_1`` at ``yaw + second``."""
+    return (Grasp(name, pos, yaw=yaw, width=width), Grasp(f"{name}_1", pos, yaw=yaw + second, width=width))
+
+
+def rim_grasps(radius: float, z: float, angles: tuple[float, ...], width: float,
+               name: str = "rim") -> tuple[Grasp, ...]:
+    """Grasps pinching a round wall at ``radius``, one per angle: the fingers close radially."""
+    return tuple(
+        Grasp(name if i == 0 else f"{name}_{i}", (radius * math.cos(a), radius * math.sin(a), z),
+              yaw=a + HALF_PI, width=width)
+        for i, a in enumerate(angles)
+    )
 
 
 @dataclass(frozen=True)

@@ -8,6 +8,7 @@ from dataclasses import dataclass, field
 from vcage.assets.annotations import Annotations, FunctionalPoint, Grasp, Placement
 from vcage.assets.parts import RGBA, PartBuilder
 from vcage.errors import CatalogError
+from vcage.registry import Registry
 
 Builder = Callable[[PartBuilder], None]
 
@@ -85,63 +86,33 @@ def _find(items: Iterable, name: str | None, what: str):  # type: ignore[no-unty
     raise CatalogError(f"unknown {what} {name!r}; valid: {[i.name for i in items]}")
 
 
-class Catalog:
-    """A queryable set of object types; unknown names list the valid ones."""
+class Catalog(Registry[ObjectType]):
+    """The object types by name: a :class:`Registry` (unknown or duplicate names raise
+    :class:`CatalogError` listing the valid ones) with queries by category and tag.
+
+    Every query answers in name order. The built-in types are added when ``vcage.assets`` is
+    imported (its ``__init__`` imports :mod:`vcage.assets.objects`), so this module needs no
+    import of its own to be full.
+    """
 
     def __init__(self) -> None:
-        self._types: dict[str, ObjectType] = {}
+        super().__init__("object type", error=CatalogError)
 
-    def add(self, obj: ObjectType) -> ObjectType:
-        if obj.name in self._types:
-            raise CatalogError(f"object type {obj.name!r} is already in the catalog")
-        self._types[obj.name] = obj
-        return obj
-
-    def get(self, name: str) -> ObjectType:
-        _load_builtin()
-        try:
-            return self._types[name]
-        except KeyError:
-            raise CatalogError(
-                f"unknown object type {name!r}; valid types: {', '.join(self.names())}"
-            ) from None
-
-    def names(self) -> list[str]:
-        _load_builtin()
-        return sorted(self._types)
+    def add_type(self, obj: ObjectType) -> ObjectType:
+        """Add ``obj`` under its own name."""
+        return self.add(obj.name, obj)
 
     def categories(self) -> list[str]:
-        _load_builtin()
-        return sorted({o.category for o in self._types.values()})
+        return sorted({o.category for o in self.values()})
 
     def by_category(self, category: str) -> list[ObjectType]:
-        found = [o for o in self.all() if o.category == category]
+        found = [o for o in self.values() if o.category == category]
         if not found:
             raise CatalogError(f"unknown category {category!r}; valid: {', '.join(self.categories())}")
         return found
 
     def by_tag(self, tag: str) -> list[ObjectType]:
-        return [o for o in self.all() if tag in o.tags]
-
-    def all(self) -> list[ObjectType]:
-        _load_builtin()
-        return [self._types[n] for n in sorted(self._types)]
-
-    def __len__(self) -> int:
-        _load_builtin()
-        return len(self._types)
-
-    def __contains__(self, name: object) -> bool:
-        _load_builtin()
-        return name in self._types
+        return [o for o in self.values() if tag in o.tags]
 
 
 CATALOG = Catalog()
-_loaded = False
-
-
-def _load_builtin() -> None:
-    global _loaded
-    if not _loaded:
-        _loaded = True
-        from vcage.assets import objects  # noqa: F401  (registers the built-in types)

@@ -9,15 +9,21 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-import mujoco
 import numpy as np
 
 from vcage.geometry import mat_to_quat, rot_y, rot_z
 
+if TYPE_CHECKING:
+    import mujoco
+
 RGBA = tuple[float, ...]  # (r, g, b, a)
 VISUAL: dict[str, Any] = {"contype": 0, "conaffinity": 0}  # geom options for decoration only
+DARK: RGBA = (0.12, 0.12, 0.13, 1.0)  # black plastic parts
+METAL: RGBA = (0.78, 0.78, 0.8, 1.0)  # steel parts
+X_AXIS_QUAT = (math.sqrt(0.5), 0.0, math.sqrt(0.5), 0.0)  # turns a cylinder's or capsule's axis onto x
+Y_AXIS_QUAT = (math.sqrt(0.5), math.sqrt(0.5), 0.0, 0.0)  # turns a cylinder's or capsule's axis onto y
 
 
 class PartBuilder:
@@ -25,6 +31,9 @@ class PartBuilder:
 
     def __init__(self, body: mujoco.MjsBody, prefix: str, scale: float, rgba: RGBA,
                  friction: float = 1.0) -> None:
+        import mujoco  # here, not at the top: the catalog's metadata is read without the simulator
+
+        self._mj = mujoco
         self.body = body
         self.prefix = prefix
         self.scale = scale
@@ -58,25 +67,25 @@ class PartBuilder:
     def box(self, half: Sequence[float], pos: Sequence[float] = (0, 0, 0), rgba: RGBA | None = None,
             name: str | None = None, quat: Sequence[float] | None = None,
             body: mujoco.MjsBody | None = None, **kw: Any) -> mujoco.MjsGeom:
-        return self._geom(mujoco.mjtGeom.mjGEOM_BOX, half, pos, rgba, name, quat, body, **kw)
+        return self._geom(self._mj.mjtGeom.mjGEOM_BOX, half, pos, rgba, name, quat, body, **kw)
 
     def cylinder(self, radius: float, half_height: float, pos: Sequence[float] = (0, 0, 0),
                  rgba: RGBA | None = None, name: str | None = None,
                  quat: Sequence[float] | None = None, body: mujoco.MjsBody | None = None,
                  **kw: Any) -> mujoco.MjsGeom:
-        return self._geom(mujoco.mjtGeom.mjGEOM_CYLINDER, [radius, half_height], pos, rgba, name,
+        return self._geom(self._mj.mjtGeom.mjGEOM_CYLINDER, [radius, half_height], pos, rgba, name,
                           quat, body, **kw)
 
     def sphere(self, radius: float, pos: Sequence[float] = (0, 0, 0), rgba: RGBA | None = None,
                name: str | None = None, body: mujoco.MjsBody | None = None,
                **kw: Any) -> mujoco.MjsGeom:
-        return self._geom(mujoco.mjtGeom.mjGEOM_SPHERE, [radius], pos, rgba, name, None, body, **kw)
+        return self._geom(self._mj.mjtGeom.mjGEOM_SPHERE, [radius], pos, rgba, name, None, body, **kw)
 
     def capsule(self, radius: float, half_length: float, pos: Sequence[float] = (0, 0, 0),
                 rgba: RGBA | None = None, name: str | None = None,
                 quat: Sequence[float] | None = None, body: mujoco.MjsBody | None = None,
                 **kw: Any) -> mujoco.MjsGeom:
-        return self._geom(mujoco.mjtGeom.mjGEOM_CAPSULE, [radius, half_length], pos, rgba, name,
+        return self._geom(self._mj.mjtGeom.mjGEOM_CAPSULE, [radius, half_length], pos, rgba, name,
                           quat, body, **kw)
 
     def ring(self, radius: float, height: float, thickness: float, segments: int = 12,
@@ -112,6 +121,20 @@ class PartBuilder:
                                   quat=quat))
         return geoms
 
+    def open_cylinder(self, radius: float, height: float, thickness: float, floor: float,
+                      segments: int = 16) -> None:
+        """A round container (a cup, a pot): a floor disc of radius ``radius`` and ``floor`` thick,
+        and a ring of walls, ``thickness`` thick, up to ``height`` with outer radius ``radius``."""
+        self.cylinder(radius, floor / 2, [0, 0, floor / 2], name="floor")
+        self.ring(radius - thickness, height - floor, thickness, segments=segments, z0=floor)
+
+    def open_box(self, half_x: float, half_y: float, wall: float, thickness: float, floor: float) -> None:
+        """A rectangular container (a basket, a tray): a floor plate ``floor`` thick and four walls
+        ``wall`` high on it around the inner rectangle of half extents ``half_x``, ``half_y``."""
+        t = thickness
+        self.box([half_x + t, half_y + t, floor / 2], [0, 0, floor / 2], name="floor")
+        self.rect_walls(half_x, half_y, wall, t, z0=floor)
+
     def rect_walls(self, half_x: float, half_y: float, height: float, thickness: float,
                    z0: float = 0.0, rgba: RGBA | None = None, body: mujoco.MjsBody | None = None,
                    name: str = "wall") -> None:
@@ -131,7 +154,7 @@ class PartBuilder:
         spec.add_mesh(name=mesh_name, uservert=(np.asarray(vertices) * self.scale).flatten().tolist(),
                       userface=np.asarray(faces, dtype=int).flatten().tolist())
         target = body if body is not None else self.body
-        geom = target.add_geom(name=self._name(name), type=mujoco.mjtGeom.mjGEOM_MESH,
+        geom = target.add_geom(name=self._name(name), type=self._mj.mjtGeom.mjGEOM_MESH,
                                meshname=mesh_name, pos=[v * self.scale for v in pos],
                                rgba=list(rgba or self.rgba),
                                friction=[self.friction, 0.005, 0.0001], condim=4)
@@ -150,7 +173,7 @@ class PartBuilder:
     def slide(self, body: mujoco.MjsBody, name: str, axis: Sequence[float], range_: tuple[float, float],
               stiffness: float, damping: float = 0.5, springref: float = 0.0) -> mujoco.MjsJoint:
         return body.add_joint(
-            name=f"{self.prefix}/{name}", type=mujoco.mjtJoint.mjJNT_SLIDE, axis=list(axis),
+            name=f"{self.prefix}/{name}", type=self._mj.mjtJoint.mjJNT_SLIDE, axis=list(axis),
             range=[range_[0] * self.scale, range_[1] * self.scale], limited=True,
             stiffness=stiffness, damping=damping, springref=springref * self.scale,
         )
@@ -167,7 +190,7 @@ class PartBuilder:
             return math.degrees(radians) if body.compiler.degree else radians
 
         return body.add_joint(
-            name=f"{self.prefix}/{name}", type=mujoco.mjtJoint.mjJNT_HINGE, axis=list(axis),
+            name=f"{self.prefix}/{name}", type=self._mj.mjtJoint.mjJNT_HINGE, axis=list(axis),
             range=[angle(range_[0]), angle(range_[1])], limited=True, stiffness=stiffness,
             damping=damping, springref=angle(springref), ref=angle(ref),
             pos=[v * self.scale for v in pos],

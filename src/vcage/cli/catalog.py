@@ -16,7 +16,7 @@ def list_catalog(category: str = typer.Option(None, help="only this category"),
     """List the annotated object catalog."""
     from vcage.assets.catalog import CATALOG
 
-    objs = CATALOG.by_category(category) if category else CATALOG.all()
+    objs = CATALOG.by_category(category) if category else CATALOG.values()
     if tag:
         objs = [o for o in objs if tag in o.tags]
     table = Table("name", "category", "size (cm)", "grasps", "placements", "functional", "description")

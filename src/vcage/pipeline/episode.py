@@ -24,8 +24,8 @@ from vcage.scene.instantiate import Instantiator, SceneInstance
 from vcage.scene.spec import SceneSpec
 from vcage.sim.render import Renderer
 from vcage.sim.world import World
+from vcage.skills.base import Skills
 from vcage.skills.playback import Player, Recording
-from vcage.skills.primitives import Skills
 from vcage.skills.reachability import reach_map
 
 

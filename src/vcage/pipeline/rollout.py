@@ -15,7 +15,7 @@ from typing import Any, Protocol
 from vcage.errors import SkillError
 from vcage.planning.schema import Plan, Subtask
 from vcage.sim.world import World
-from vcage.skills.primitives import Skills
+from vcage.skills.base import Skills
 from vcage.tasks.oracle import Oracle
 from vcage.tasks.success import held
 

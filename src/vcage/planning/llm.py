@@ -28,7 +28,7 @@ def skill_library() -> str:
 
 def catalog_lines() -> str:
     lines = []
-    for t in CATALOG.all():
+    for t in CATALOG.values():
         holds = ", ".join(f"{p.kind} '{p.name}'" for p in t.placements)
         points = ", ".join(f.name for f in t.functional_points if f.joint)
         extra = (f"; holds objects {holds}" if holds else "") + (f"; pressable at {points}" if points else "")

@@ -26,7 +26,7 @@ _PLACE = re.compile(r"^(?:please\s+)?(?:put|place|move|set|drop|lay|stack|nest|b
 _PRESS = re.compile(r"^(?:please\s+)?(?:press|push|click|ring|hit|tap|silence|flip|toggle|turn on|turn off|"
                     r"switch on|switch off|use)\s+(?P<obj>.+)$")
 SIZES = {"small": 0.85, "little": 0.85, "smaller": 0.85, "large": None, "big": None, "larger": None}
-_COLOR_WORDS = frozenset(c for t in CATALOG.all() for c in t.colors)
+_COLOR_WORDS = frozenset(c for t in CATALOG.values() for c in t.colors)
 # spoken names -> catalog types (besides the type names themselves, with spaces)
 ALIASES = {
     "pad": "mouse_pad", "mousepad": "mouse_pad", "stand": "object_stand", "display stand": "object_stand",
@@ -134,7 +134,7 @@ class OfflinePlanner:
             if kind is None:
                 raise PlanningError(f"nothing can be put on or in the {t.type.replace('_', ' ')} "
                                     f"(in {clause!r}); objects that hold others: "
-                                    f"{', '.join(x.name for x in CATALOG.all() if x.placements)}")
+                                    f"{', '.join(x.name for x in CATALOG.values() if x.placements)}")
             return (put_in if kind == "in" else put_on)(obj, target, text)
         m = _PRESS.match(clause)
         if m:

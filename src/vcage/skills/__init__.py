@@ -1,1 +1,9 @@
-"""Skills: inverse kinematics, motion plans, their execution, and manipulation primitives."""
+"""Skills: IK, motion plans and their playback, and the manipulation primitives.
+
+Importing the package registers the primitives in ``SKILLS``.
+"""
+
+from vcage.skills import primitives  # noqa: F401  (registers the primitives)
+from vcage.skills.base import SKILLS, Skills
+
+__all__ = ["SKILLS", "Skills"]

@@ -22,7 +22,7 @@ from vcage.registry import Registry
 from vcage.scene.layout import LayoutSpec, Relation, ReservedZone
 from vcage.scene.spec import SceneSpec
 from vcage.sim.world import World
-from vcage.skills.primitives import Skills
+from vcage.skills.base import Skills
 from vcage.tasks.items import Item, task_layout
 from vcage.tasks.oracle import Oracle
 from vcage.tasks.success import HOLD_STEPS

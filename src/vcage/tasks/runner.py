@@ -13,8 +13,8 @@ from vcage.scene.instantiate import Instantiator, SceneConfig
 from vcage.scene.placement import PlacementStats
 from vcage.scene.spec import SceneSpec
 from vcage.sim.world import World
+from vcage.skills.base import Skills
 from vcage.skills.playback import Recording
-from vcage.skills.primitives import Skills
 from vcage.skills.reachability import reach_map
 from vcage.tasks.base import TASKS, AtomicTask
 from vcage.tasks.success import held

@@ -10,7 +10,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
-from vcage.skills.primitives import Skills
+from vcage.skills.base import Skills
 
 HOLD_STEPS = 5  # consecutive control steps a success check must hold
 PRESS_STEPS = 2  # consecutive control steps a press must last to count

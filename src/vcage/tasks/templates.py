@@ -8,7 +8,7 @@ from __future__ import annotations
 from typing import ClassVar
 
 from vcage.planning.schema import Predicate
-from vcage.skills.primitives import Skills
+from vcage.skills.base import Skills
 from vcage.tasks.base import AtomicTask, pred
 
 

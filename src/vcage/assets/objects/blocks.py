@@ -23,7 +23,7 @@ def _cube(p: PartBuilder) -> None:
     p.box([BLOCK / 2] * 3, [0, 0, BLOCK / 2], name="body")
 
 
-CATALOG.add(ObjectType(
+CATALOG.add_type(ObjectType(
     name="block", category="toy", description="a small wooden cube block",
     size=(BLOCK, BLOCK, BLOCK), mass=0.06, colors=BLOCK_COLORS, build=_cube,
     tags=frozenset({"block", "stackable", "graspable", "colored"}), scale_range=(0.95, 1.05),

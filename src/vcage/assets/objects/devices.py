@@ -15,16 +15,10 @@ import math
 
 import numpy as np
 
-from vcage.assets.annotations import Annotations, FunctionalPoint, Grasp, Placement
+from vcage.assets.annotations import HALF_PI, Annotations, FunctionalPoint, Grasp, Placement, grasp_pair
 from vcage.assets.catalog import CATALOG, ObjectType
-from vcage.assets.parts import VISUAL, PartBuilder
+from vcage.assets.parts import DARK, METAL, RGBA, VISUAL, X_AXIS_QUAT, Y_AXIS_QUAT, PartBuilder
 from vcage.geometry import mat_to_quat, rot_y
-
-HALF_PI = math.pi / 2
-METAL = (0.78, 0.78, 0.8, 1.0)
-DARK = (0.12, 0.12, 0.13, 1.0)
-Y_AXIS_QUAT = (math.sqrt(0.5), math.sqrt(0.5), 0.0, 0.0)  # turns a cylinder's axis onto y
-X_AXIS_QUAT = (math.sqrt(0.5), 0.0, math.sqrt(0.5), 0.0)  # turns a cylinder's axis onto x
 
 # Push buttons rest at their upper limit, which is also the spring's reference (so the joint's
 # ``qpos_spring`` is its rest value). The spring is stiff enough that the light button sags only
@@ -36,7 +30,7 @@ BUTTON_TRAVEL = 0.004
 
 
 def _button(p: PartBuilder, pos: tuple[float, float, float], radius: float, height: float,
-            rgba: tuple[float, float, float, float]) -> None:
+            rgba: RGBA) -> None:
     """A push button whose body origin is at ``pos`` (the base of its cap) moving along z."""
     body = p.child("button", pos=pos, mass=BUTTON_MASS)
     body.ipos = [0.0, 0.0, height / 2 * p.scale]
@@ -66,7 +60,7 @@ def _bell(p: PartBuilder) -> None:
 
 
 _BELL_TOP = round(BELL_BUTTON_Z + BELL_BUTTON_H, 4)
-CATALOG.add(ObjectType(
+CATALOG.add_type(ObjectType(
     name="bell", category="device", description="a desk service bell with a push button on top",
     size=(2 * BELL_BASE_R, 2 * BELL_BASE_R, _BELL_TOP), mass=0.3,
     colors={"gold": (0.85, 0.68, 0.25, 1.0), "silver": (0.8, 0.8, 0.83, 1.0),
@@ -102,7 +96,7 @@ def _alarm_clock(p: PartBuilder) -> None:
 
 
 _CLOCK_H = round(CLOCK_TOP + CLOCK_BUTTON_H, 4)
-CATALOG.add(ObjectType(
+CATALOG.add_type(ObjectType(
     name="alarm_clock", category="device", description="an alarm clock with a button on top",
     size=(2 * CLOCK_HALF[0] + 0.006, 2 * CLOCK_HALF[1], _CLOCK_H), mass=0.25,
     colors={"white": (0.92, 0.92, 0.9, 1.0), "blue": (0.25, 0.45, 0.75, 1.0),
@@ -159,15 +153,14 @@ _STAPLER_PRESS = _vec3(_stapler_point(STAPLER_ARM_LEN - 0.015, 0.015))
 # the press point's drop from the open arm to the closed one
 _STAPLER_STROKE = round(float(_STAPLER_PRESS[2] - _stapler_point(STAPLER_ARM_LEN - 0.015, 0.015, 0.0)[2]), 4)
 _STAPLER_TOP = float(_stapler_point(STAPLER_ARM_LEN, 0.015)[2])
-CATALOG.add(ObjectType(
+CATALOG.add_type(ObjectType(
     name="stapler", category="device", description="a desk stapler with a spring-loaded arm",
     size=(2 * STAPLER_BASE[0] + 0.004, 0.04, round(_STAPLER_TOP + 0.002, 4)), mass=0.2,
     colors={"red": (0.78, 0.14, 0.12, 1.0), "black": (0.2, 0.2, 0.22, 1.0),
             "blue": (0.2, 0.35, 0.7, 1.0)},
     build=_stapler, tags=frozenset({"pressable", "device", "articulated", "office", "graspable"}),
     annotations=Annotations(
-        grasps=(Grasp("body", (0.0, 0.0, 0.04), yaw=0.0, width=0.036),
-                Grasp("body_1", (0.0, 0.0, 0.04), yaw=math.pi, width=0.036)),
+        grasps=grasp_pair("body", (0.0, 0.0, 0.04), 0.036, second=math.pi),
         functional_points=(FunctionalPoint("press", "lever", _STAPLER_PRESS, joint="arm",
                                            travel=0.15, stroke=_STAPLER_STROKE),),
     ),
@@ -210,7 +203,7 @@ _SWITCH_OFF = _vec3(_switch_point(-SWITCH_ROCKER[0] * 0.7, SWITCH_THROW))
 # the "on" point's drop from the off pose to the fully thrown one (past vertical it tips over)
 _SWITCH_STROKE = round(float(_SWITCH_ON[2] - _switch_point(SWITCH_ROCKER[0] * 0.7, SWITCH_THROW)[2]), 4)
 _SWITCH_TOP = float(_switch_point(SWITCH_ROCKER[0])[2])
-CATALOG.add(ObjectType(
+CATALOG.add_type(ObjectType(
     name="switch", category="device", description="a rocker switch on a small base",
     size=(2 * SWITCH_BASE[0], 2 * SWITCH_BASE[1], round(_SWITCH_TOP + 0.002, 4)), mass=0.15,
     colors={"red": (0.8, 0.15, 0.12, 1.0), "black": (0.15, 0.15, 0.16, 1.0),
@@ -246,15 +239,14 @@ def _seal(p: PartBuilder) -> None:
 
 
 _SEAL_GRASP_Z = _SEAL_HANDLE_Z0 + 0.042  # finger tips clear the block, the palm the knob
-CATALOG.add(ObjectType(
+CATALOG.add_type(ObjectType(
     name="seal", category="office", description="a rubber stamp with a wooden handle",
     size=(2 * SEAL_BASE[0], 2 * SEAL_BASE[1], round(_SEAL_TOP, 4)), mass=0.12,
     colors={"red": (0.8, 0.12, 0.12, 1.0), "blue": (0.15, 0.25, 0.75, 1.0),
             "black": (0.1, 0.1, 0.1, 1.0)},
     build=_seal, tags=frozenset({"graspable", "office", "tool", "stamp"}),
     annotations=Annotations(
-        grasps=(Grasp("handle", (0, 0, _SEAL_GRASP_Z), yaw=0.0, width=2 * SEAL_HANDLE_R),
-                Grasp("handle_1", (0, 0, _SEAL_GRASP_Z), yaw=HALF_PI, width=2 * SEAL_HANDLE_R)),
+        grasps=grasp_pair("handle", (0, 0, _SEAL_GRASP_Z), 2 * SEAL_HANDLE_R),
         functional_points=(FunctionalPoint("face", "stamp", (0, 0, 0)),),
     ),
 ))
@@ -270,7 +262,7 @@ def _stamp_mat(p: PartBuilder) -> None:
     p.box([MAT_HALF[0] - 0.006, MAT_HALF[1] - 0.006, 0.001], [0, 0, MAT_H - 0.001], name="ink")
 
 
-CATALOG.add(ObjectType(
+CATALOG.add_type(ObjectType(
     name="stamp_mat", category="office", description="a flat inked stamp pad",
     size=(2 * MAT_HALF[0], 2 * MAT_HALF[1], MAT_H), mass=0.06,
     colors={"red": (0.8, 0.12, 0.12, 1.0), "blue": (0.15, 0.25, 0.75, 1.0),

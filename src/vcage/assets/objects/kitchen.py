@@ -7,23 +7,14 @@ from __future__ import annotations
 
 import math
 
-from vcage.assets.annotations import Annotations, Grasp, StableOrientation
+from vcage.assets.annotations import HALF_PI, Annotations, Grasp, StableOrientation, grasp_pair
 from vcage.assets.catalog import CATALOG, ObjectType
-from vcage.assets.parts import VISUAL, PartBuilder
+from vcage.assets.parts import METAL, VISUAL, X_AXIS_QUAT, PartBuilder
 from vcage.geometry import mat_to_quat, rot_y, rot_z
 
-HALF_PI = math.pi / 2
-METAL = (0.78, 0.78, 0.8, 1.0)
-X_AXIS_QUAT = (math.sqrt(0.5), 0.0, math.sqrt(0.5), 0.0)  # turns a capsule's axis onto x
 # The hand's palm is ~47 mm above the grasp point, so grasps on tall things sit near their top.
 PALM_CLEARANCE = 0.044
 LYING = StableOrientation("lying", (math.sqrt(0.5), math.sqrt(0.5), 0.0, 0.0))
-
-
-def _pair(name: str, pos: tuple[float, float, float], width: float, yaw: float = 0.0,
-          second: float = HALF_PI) -> tuple[Grasp, Grasp]:
-    """Two top-down grasps at ``pos``: at ``yaw`` and at ``yaw + second``."""
-    return (Grasp(name, pos, yaw=yaw, width=width), Grasp(f"{name}_1", pos, yaw=yaw + second, width=width))
 
 
 # --- can ----------------------------------------------------------------------------------------
@@ -38,14 +29,14 @@ def _can(p: PartBuilder) -> None:
           **VISUAL)
 
 
-CATALOG.add(ObjectType(
+CATALOG.add_type(ObjectType(
     name="can", category="food", description="a soda can",
     size=(2 * CAN_R, 2 * CAN_R, CAN_H), mass=0.2,
     colors={"red": (0.8, 0.1, 0.1, 1.0), "green": (0.15, 0.55, 0.25, 1.0),
             "blue": (0.15, 0.3, 0.75, 1.0), "silver": (0.75, 0.76, 0.78, 1.0)},
     build=_can, tags=frozenset({"graspable", "food", "kitchen", "drink", "cylindrical"}),
     annotations=Annotations(
-        grasps=(*_pair("side", (0, 0, 0.08), 2 * CAN_R),
+        grasps=(*grasp_pair("side", (0, 0, 0.08), 2 * CAN_R),
                 Grasp("side_2", (0, 0, 0.08), yaw=math.pi / 4, width=2 * CAN_R)),
         stable_orientations=(StableOrientation("upright"), LYING),
     ),
@@ -67,16 +58,15 @@ def _bottle(p: PartBuilder) -> None:
     p.cylinder(BOTTLE_R + 0.0005, 0.025, [0, 0, 0.07], (0.95, 0.95, 0.92, 1.0), name="label", **VISUAL)
 
 
-CATALOG.add(ObjectType(
+CATALOG.add_type(ObjectType(
     name="bottle", category="kitchen", description="a plastic water bottle with a cap",
     size=(2 * BOTTLE_R, 2 * BOTTLE_R, BOTTLE_H), mass=0.25,
     colors={"blue": (0.45, 0.65, 0.9, 1.0), "green": (0.35, 0.7, 0.45, 1.0),
             "clear": (0.8, 0.87, 0.9, 1.0)},
     build=_bottle, tags=frozenset({"graspable", "kitchen", "drink", "cylindrical"}),
     annotations=Annotations(
-        grasps=(Grasp("neck", (0, 0, BOTTLE_H - BOTTLE_CAP_H), yaw=0.0, width=2 * BOTTLE_CAP_R),
-                Grasp("neck_1", (0, 0, BOTTLE_H - BOTTLE_CAP_H), yaw=HALF_PI, width=2 * BOTTLE_CAP_R),
-                *_pair("body", (0, 0, BOTTLE_H - PALM_CLEARANCE), 2 * BOTTLE_R)),
+        grasps=(*grasp_pair("neck", (0, 0, BOTTLE_H - BOTTLE_CAP_H), 2 * BOTTLE_CAP_R),
+                *grasp_pair("body", (0, 0, BOTTLE_H - PALM_CLEARANCE), 2 * BOTTLE_R)),
         stable_orientations=(StableOrientation("upright"), LYING),
     ),
 ))
@@ -91,14 +81,14 @@ def _jar(p: PartBuilder) -> None:
                (0.8, 0.7, 0.2, 1.0), name="lid")
 
 
-CATALOG.add(ObjectType(
+CATALOG.add_type(ObjectType(
     name="jar", category="food", description="a glass jar of jam with a metal lid",
     size=(2 * JAR_R + 0.002, 2 * JAR_R + 0.002, JAR_BODY_H + JAR_LID_H), mass=0.25,
     colors={"strawberry": (0.7, 0.1, 0.15, 1.0), "apricot": (0.95, 0.6, 0.2, 1.0),
             "honey": (0.9, 0.7, 0.2, 1.0)},
     build=_jar, tags=frozenset({"graspable", "food", "kitchen", "cylindrical"}),
     annotations=Annotations(
-        grasps=(*_pair("body", (0, 0, 0.06), 2 * JAR_R),
+        grasps=(*grasp_pair("body", (0, 0, 0.06), 2 * JAR_R),
                 Grasp("lid", (0, 0, JAR_BODY_H + JAR_LID_H / 2), width=2 * JAR_R + 0.002)),
     ),
 ))
@@ -123,13 +113,13 @@ def _apple(p: PartBuilder) -> None:
           name="leaf", quat=mat_to_quat(rot_y(-0.4)).tolist(), **VISUAL)
 
 
-CATALOG.add(ObjectType(
+CATALOG.add_type(ObjectType(
     name="apple", category="food", description="an apple",
     size=(2 * APPLE_R, 2 * APPLE_R, APPLE_H), mass=0.12,
     colors={"red": (0.78, 0.1, 0.1, 1.0), "green": (0.5, 0.78, 0.25, 1.0),
             "yellow": (0.92, 0.82, 0.3, 1.0)},
     build=_apple, tags=frozenset({"graspable", "food", "fruit"}),
-    annotations=Annotations(grasps=_pair("top", (0, 0, APPLE_R + 0.002), 2 * APPLE_R)),
+    annotations=Annotations(grasps=grasp_pair("top", (0, 0, APPLE_R + 0.002), 2 * APPLE_R)),
 ))
 
 ORANGE_R = 0.032
@@ -140,12 +130,12 @@ def _orange(p: PartBuilder) -> None:
     p.sphere(0.003, [0, 0, zc + ORANGE_R - 0.002], (0.4, 0.45, 0.15, 1.0), name="navel", **VISUAL)
 
 
-CATALOG.add(ObjectType(
+CATALOG.add_type(ObjectType(
     name="orange", category="food", description="an orange",
     size=(2 * ORANGE_R, 2 * ORANGE_R, 2 * ORANGE_R + 0.003), mass=0.13,
     colors={"orange": (0.98, 0.55, 0.1, 1.0), "tangerine": (0.95, 0.45, 0.05, 1.0)},
     build=_orange, tags=frozenset({"graspable", "food", "fruit"}),
-    annotations=Annotations(grasps=_pair("top", (0, 0, ORANGE_R + 0.0015), 2 * ORANGE_R)),
+    annotations=Annotations(grasps=grasp_pair("top", (0, 0, ORANGE_R + 0.0015), 2 * ORANGE_R)),
 ))
 
 # --- banana -------------------------------------------------------------------------------------
@@ -179,13 +169,13 @@ def _banana(p: PartBuilder) -> None:
 
 
 _BANANA_X = BANANA_ARC_R * math.sin(BANANA_SPAN) + 0.03
-CATALOG.add(ObjectType(
+CATALOG.add_type(ObjectType(
     name="banana", category="food", description="a ripe banana",
     size=(2 * _BANANA_X, round(_BANANA_SAG + 2 * BANANA_R + 0.004, 4), 2 * BANANA_R), mass=0.12,
     colors={"yellow": (0.96, 0.85, 0.25, 1.0), "green": (0.65, 0.78, 0.25, 1.0)},
     build=_banana, tags=frozenset({"graspable", "food", "fruit"}),
     annotations=Annotations(
-        grasps=_pair("middle", (0, _banana_point(0.0)[1], 0.02), 2 * BANANA_R, second=math.pi),
+        grasps=grasp_pair("middle", (0, _banana_point(0.0)[1], 0.02), 2 * BANANA_R, second=math.pi),
     ),
 ))
 
@@ -204,15 +194,15 @@ def _bread(p: PartBuilder) -> None:
               quat=mat_to_quat(rot_z(0.5)).tolist(), **VISUAL)
 
 
-CATALOG.add(ObjectType(
+CATALOG.add_type(ObjectType(
     name="bread", category="food", description="a small loaf of bread",
     size=BREAD, mass=0.15,
     colors={"wheat": (0.82, 0.6, 0.33, 1.0), "rye": (0.48, 0.32, 0.18, 1.0),
             "white": (0.93, 0.82, 0.6, 1.0)},
     build=_bread, tags=frozenset({"graspable", "food", "soft"}),
     annotations=Annotations(
-        grasps=(*_pair("top", (0, 0, 0.045), BREAD[1], second=math.pi),
-                *_pair("top_end", (0.035, 0, 0.045), BREAD[1], second=math.pi)),
+        grasps=(*grasp_pair("top", (0, 0, 0.045), BREAD[1], second=math.pi),
+                *grasp_pair("top_end", (0.035, 0, 0.045), BREAD[1], second=math.pi)),
     ),
 ))
 
@@ -229,13 +219,13 @@ def _sponge(p: PartBuilder) -> None:
           name="scrub")
 
 
-CATALOG.add(ObjectType(
+CATALOG.add_type(ObjectType(
     name="sponge", category="kitchen", description="a kitchen sponge with a scrubbing side",
     size=SPONGE, mass=0.02,
     colors={"yellow": (0.97, 0.85, 0.3, 1.0), "pink": (0.95, 0.6, 0.7, 1.0),
             "blue": (0.45, 0.65, 0.9, 1.0)},
     build=_sponge, tags=frozenset({"graspable", "kitchen", "soft", "stackable"}),
-    annotations=Annotations(grasps=_pair("top", (0, 0, 0.022), SPONGE[1], second=math.pi)),
+    annotations=Annotations(grasps=grasp_pair("top", (0, 0, 0.022), SPONGE[1], second=math.pi)),
 ))
 
 # --- soap ---------------------------------------------------------------------------------------
@@ -248,13 +238,13 @@ def _soap(p: PartBuilder) -> None:
     p.box([sx / 2 - 0.004, sy / 2 - 0.004, sz * 0.15], [0, 0, sz * 0.85], name="top")
 
 
-CATALOG.add(ObjectType(
+CATALOG.add_type(ObjectType(
     name="soap", category="kitchen", description="a bar of soap",
     size=SOAP, mass=0.1,
     colors={"white": (0.95, 0.95, 0.93, 1.0), "lavender": (0.75, 0.65, 0.88, 1.0),
             "green": (0.6, 0.85, 0.6, 1.0)},
     build=_soap, tags=frozenset({"graspable", "kitchen", "stackable"}),
-    annotations=Annotations(grasps=_pair("top", (0, 0, 0.02), SOAP[1], second=math.pi)),
+    annotations=Annotations(grasps=grasp_pair("top", (0, 0, 0.02), SOAP[1], second=math.pi)),
 ))
 
 # --- cereal box ---------------------------------------------------------------------------------
@@ -271,12 +261,12 @@ def _cereal_box(p: PartBuilder) -> None:
                    name=f"bowl_art_{side}", quat=X_AXIS_QUAT, **VISUAL)
 
 
-CATALOG.add(ObjectType(
+CATALOG.add_type(ObjectType(
     name="cereal_box", category="food", description="a small box of breakfast cereal",
     size=CEREAL, mass=0.2,
     colors={"red": (0.75, 0.15, 0.15, 1.0), "blue": (0.2, 0.35, 0.75, 1.0),
             "green": (0.25, 0.6, 0.3, 1.0)},
     build=_cereal_box, tags=frozenset({"graspable", "food", "kitchen"}),
-    annotations=Annotations(grasps=_pair("side", (0, 0, CEREAL[2] - PALM_CLEARANCE), CEREAL[0], yaw=HALF_PI,
-                                         second=math.pi)),
+    annotations=Annotations(grasps=grasp_pair("side", (0, 0, CEREAL[2] - PALM_CLEARANCE), CEREAL[0],
+                                              yaw=HALF_PI, second=math.pi)),
 ))

@@ -10,25 +10,23 @@ from collections.abc import Iterator
 
 import numpy as np
 
-from vcage.assets.annotations import Annotations, Grasp, Placement, StableOrientation
+from vcage.assets.annotations import (
+    FOUR_SIDES,
+    HALF_PI,
+    RIM_DROP,
+    Annotations,
+    Grasp,
+    Placement,
+    StableOrientation,
+    grasp_pair,
+    rim_grasps,
+)
 from vcage.assets.catalog import CATALOG, ObjectType
-from vcage.assets.parts import VISUAL, PartBuilder
+from vcage.assets.parts import DARK, VISUAL, X_AXIS_QUAT, Y_AXIS_QUAT, PartBuilder
 from vcage.geometry import mat_to_quat, rot_y
 
-HALF_PI = math.pi / 2
 S2 = math.sqrt(0.5)
-DARK = (0.12, 0.12, 0.13, 1.0)
 WHITE = (0.95, 0.95, 0.94, 1.0)
-X_AXIS_QUAT = (S2, 0.0, S2, 0.0)  # turns a cylinder's axis onto x
-Y_AXIS_QUAT = (S2, S2, 0.0, 0.0)  # turns a cylinder's axis onto y
-INV_SQRT2 = S2
-RIM_DROP = 0.015
-
-
-def _pair(name: str, pos: tuple[float, float, float], width: float, yaw: float = 0.0,
-          second: float = HALF_PI) -> tuple[Grasp, Grasp]:
-    """Two top-down grasps at ``pos``: at ``yaw`` and at ``yaw + second``."""
-    return (Grasp(name, pos, yaw=yaw, width=width), Grasp(f"{name}_1", pos, yaw=yaw + second, width=width))
 
 
 def _cube_faces(half: float) -> Iterator[tuple[str, np.ndarray, np.ndarray, np.ndarray]]:
@@ -58,13 +56,13 @@ def _mouse(p: PartBuilder) -> None:
     p.cylinder(0.003, 0.004, [0.03, 0, sz - 0.003], DARK, name="wheel", quat=Y_AXIS_QUAT, **VISUAL)
 
 
-CATALOG.add(ObjectType(
+CATALOG.add_type(ObjectType(
     name="mouse", category="electronics", description="a computer mouse",
     size=MOUSE, mass=0.08,
     colors={"black": (0.16, 0.16, 0.17, 1.0), "white": (0.9, 0.9, 0.9, 1.0),
             "gray": (0.55, 0.56, 0.58, 1.0)},
     build=_mouse, tags=frozenset({"graspable", "office", "electronics"}),
-    annotations=Annotations(grasps=_pair("top", (0, 0, 0.022), MOUSE[1], second=math.pi)),
+    annotations=Annotations(grasps=grasp_pair("top", (0, 0, 0.022), MOUSE[1], second=math.pi)),
 ))
 
 # --- mouse pad ----------------------------------------------------------------------------------
@@ -76,7 +74,7 @@ def _mouse_pad(p: PartBuilder) -> None:
     p.box([sx / 2, sy / 2, sz / 2], [0, 0, sz / 2], name="pad")
 
 
-CATALOG.add(ObjectType(
+CATALOG.add_type(ObjectType(
     name="mouse_pad", category="office", description="a flat mouse pad",
     size=MOUSE_PAD, mass=0.05,
     colors={"black": (0.1, 0.1, 0.11, 1.0), "blue": (0.15, 0.25, 0.55, 1.0),
@@ -99,14 +97,14 @@ def _phone(p: PartBuilder) -> None:
           name="screen", **VISUAL)
 
 
-CATALOG.add(ObjectType(
+CATALOG.add_type(ObjectType(
     name="phone", category="electronics", description="a smartphone lying screen up",
     size=(PHONE[0], PHONE[1], PHONE[2] + 0.0006), mass=0.15,
     colors={"black": (0.15, 0.15, 0.16, 1.0), "silver": (0.75, 0.76, 0.78, 1.0),
             "blue": (0.25, 0.4, 0.65, 1.0), "pink": (0.9, 0.65, 0.7, 1.0)},
     build=_phone, tags=frozenset({"graspable", "flat", "electronics", "office"}),
     annotations=Annotations(
-        grasps=_pair("top", (0, 0, PHONE[2] / 2), PHONE[0], yaw=HALF_PI, second=math.pi),
+        grasps=grasp_pair("top", (0, 0, PHONE[2] / 2), PHONE[0], yaw=HALF_PI, second=math.pi),
     ),
 ))
 
@@ -138,7 +136,7 @@ def _phone_stand(p: PartBuilder) -> None:
 
 
 _SLOT_X = float(_RAMP_TOP[0])
-CATALOG.add(ObjectType(
+CATALOG.add_type(ObjectType(
     name="phone_stand", category="office", description="a phone stand with a slanted back and a lip",
     size=(2 * max(STAND_FRONT[0] + 0.006, -_STAND_BACK_X), 2 * STAND_HALF_Y, round(float(_RAMP_BACK[1]), 4)),
     mass=0.12,
@@ -161,7 +159,7 @@ def _playing_card(p: PartBuilder) -> None:
     p.box([sx / 2 - 0.004, sy / 2 - 0.004, 0.0001], [0, 0, sz + 0.0001], name="back", **VISUAL)
 
 
-CATALOG.add(ObjectType(
+CATALOG.add_type(ObjectType(
     name="playing_card", category="toy", description="a playing card lying face down",
     size=CARD, mass=0.002,
     colors={"red": (0.75, 0.12, 0.15, 1.0), "blue": (0.15, 0.25, 0.65, 1.0)},
@@ -184,7 +182,7 @@ def _book(p: PartBuilder) -> None:
           (0.95, 0.93, 0.86, 1.0), name="pages")
 
 
-CATALOG.add(ObjectType(
+CATALOG.add_type(ObjectType(
     name="book", category="office", description="a hardcover book lying flat",
     size=BOOK, mass=0.3,
     colors={"red": (0.6, 0.12, 0.12, 1.0), "blue": (0.15, 0.22, 0.5, 1.0),
@@ -213,13 +211,13 @@ def _marker(p: PartBuilder) -> None:
               name=f"foot_{side}")
 
 
-CATALOG.add(ObjectType(
+CATALOG.add_type(ObjectType(
     name="marker", category="office", description="a whiteboard marker",
     size=(MARKER_LEN, 2 * (_MARKER_END_R + 0.003), 2 * _MARKER_END_R), mass=0.015,
     colors={"black": (0.1, 0.1, 0.1, 1.0), "red": (0.8, 0.12, 0.12, 1.0),
             "blue": (0.15, 0.3, 0.8, 1.0), "green": (0.15, 0.6, 0.25, 1.0)},
     build=_marker, tags=frozenset({"graspable", "office", "pen"}),
-    annotations=Annotations(grasps=_pair("top", (0, 0, 0.02), 2 * MARKER_R, second=math.pi)),
+    annotations=Annotations(grasps=grasp_pair("top", (0, 0, 0.02), 2 * MARKER_R, second=math.pi)),
 ))
 
 # --- tape ---------------------------------------------------------------------------------------
@@ -231,14 +229,14 @@ def _tape(p: PartBuilder) -> None:
     p.ring(TAPE_R_IN - 0.002, TAPE_H, 0.002, segments=16, rgba=(0.8, 0.68, 0.48, 1.0), name="core")
 
 
-CATALOG.add(ObjectType(
+CATALOG.add_type(ObjectType(
     name="tape", category="office", description="a roll of masking tape",
     size=(2 * TAPE_R_OUT, 2 * TAPE_R_OUT, TAPE_H), mass=0.05,
     colors={"beige": (0.92, 0.86, 0.68, 1.0), "blue": (0.35, 0.55, 0.85, 1.0),
             "gray": (0.6, 0.62, 0.64, 1.0)},
     build=_tape, tags=frozenset({"graspable", "office", "round"}),
     annotations=Annotations(
-        grasps=(*_pair("top", (0, 0, 0.02), 2 * TAPE_R_OUT, second=math.pi),
+        grasps=(*grasp_pair("top", (0, 0, 0.02), 2 * TAPE_R_OUT, second=math.pi),
                 Grasp("rim", ((TAPE_R_OUT + TAPE_R_IN) / 2, 0, 0.02), yaw=HALF_PI,
                       width=TAPE_R_OUT - TAPE_R_IN)),
         stable_orientations=(StableOrientation("flat"),
@@ -259,7 +257,7 @@ def _object_stand(p: PartBuilder) -> None:
     p.box([t, t, _PLATE / 2], [0, 0, PEDESTAL_H - _PLATE / 2], name="top")
 
 
-CATALOG.add(ObjectType(
+CATALOG.add_type(ObjectType(
     name="object_stand", category="office", description="a small square display pedestal",
     size=(2 * PEDESTAL_BASE, 2 * PEDESTAL_BASE, PEDESTAL_H), mass=0.2,
     colors={"white": (0.93, 0.93, 0.92, 1.0), "black": (0.16, 0.16, 0.17, 1.0),
@@ -297,14 +295,14 @@ def _dice(p: PartBuilder) -> None:
             p.sphere(0.0035, pos.tolist(), pip_rgba, name=f"pip{n}_{k}", **VISUAL)
 
 
-CATALOG.add(ObjectType(
+CATALOG.add_type(ObjectType(
     name="dice", category="toy", description="a large foam die",
     size=(DICE, DICE, DICE), mass=0.03,
     colors={"white": (0.95, 0.95, 0.93, 1.0), "red": (0.8, 0.12, 0.12, 1.0),
             "green": (0.2, 0.6, 0.3, 1.0)},
     build=_dice, tags=frozenset({"graspable", "toy", "stackable", "cube"}), scale_range=(0.95, 1.1),
     annotations=Annotations(
-        grasps=_pair("top", (0, 0, 0.025), DICE),
+        grasps=grasp_pair("top", (0, 0, 0.025), DICE),
         stable_orientations=(
             StableOrientation("1_up"),
             StableOrientation("6_up", (0.0, 1.0, 0.0, 0.0)),
@@ -332,13 +330,13 @@ def _toy_car(p: PartBuilder) -> None:
                    quat=Y_AXIS_QUAT)
 
 
-CATALOG.add(ObjectType(
+CATALOG.add_type(ObjectType(
     name="toy_car", category="toy", description="a small toy car",
     size=CAR, mass=0.08,
     colors={"red": (0.85, 0.12, 0.1, 1.0), "blue": (0.15, 0.35, 0.85, 1.0),
             "yellow": (0.95, 0.8, 0.1, 1.0), "green": (0.2, 0.65, 0.3, 1.0)},
     build=_toy_car, tags=frozenset({"graspable", "toy"}),
-    annotations=Annotations(grasps=_pair("top", (0, 0, 0.032), CAR[1], second=math.pi)),
+    annotations=Annotations(grasps=grasp_pair("top", (0, 0, 0.032), CAR[1], second=math.pi)),
 ))
 
 # --- tennis ball --------------------------------------------------------------------------------
@@ -351,13 +349,13 @@ def _tennis_ball(p: PartBuilder) -> None:
     ball.friction = [p.friction, 0.005, 0.002]
 
 
-CATALOG.add(ObjectType(
+CATALOG.add_type(ObjectType(
     name="tennis_ball", category="toy", description="a tennis ball",
     size=(2 * BALL_R, 2 * BALL_R, 2 * BALL_R), mass=0.058,
     colors={"yellow": (0.85, 0.92, 0.2, 1.0), "orange": (0.98, 0.6, 0.15, 1.0)},
     build=_tennis_ball, tags=frozenset({"graspable", "toy", "round", "rollable"}),
     scale_range=(0.95, 1.05),
-    annotations=Annotations(grasps=_pair("top", (0, 0, BALL_R), 2 * BALL_R)),
+    annotations=Annotations(grasps=grasp_pair("top", (0, 0, BALL_R), 2 * BALL_R)),
 ))
 
 # --- Rubik's cube -------------------------------------------------------------------------------
@@ -383,13 +381,13 @@ def _rubik_cube(p: PartBuilder) -> None:
                       **VISUAL)
 
 
-CATALOG.add(ObjectType(
+CATALOG.add_type(ObjectType(
     name="rubik_cube", category="toy", description="a Rubik's cube",
     size=(RUBIK, RUBIK, RUBIK), mass=0.09,
     colors={"black": (0.08, 0.08, 0.09, 1.0)},
     build=_rubik_cube, tags=frozenset({"graspable", "toy", "stackable", "cube", "colorful"}),
     scale_range=(0.95, 1.05),
-    annotations=Annotations(grasps=_pair("top", (0, 0, 0.035), RUBIK)),
+    annotations=Annotations(grasps=grasp_pair("top", (0, 0, 0.035), RUBIK)),
 ))
 
 # --- tissue box ---------------------------------------------------------------------------------
@@ -403,7 +401,7 @@ def _tissue_box(p: PartBuilder) -> None:
     p.box([0.025, 0.002, 0.012], [0, 0, sz + 0.012], WHITE, name="tissue", **VISUAL)
 
 
-CATALOG.add(ObjectType(
+CATALOG.add_type(ObjectType(
     name="tissue_box", category="household", description="a cube-shaped box of tissues",
     size=(TISSUE[0], TISSUE[1], TISSUE[2] + 0.024), mass=0.15,
     colors={"blue": (0.4, 0.6, 0.85, 1.0), "green": (0.5, 0.75, 0.5, 1.0),
@@ -416,25 +414,21 @@ HOLDER_R, HOLDER_H, HOLDER_T, HOLDER_FLOOR = 0.04, 0.1, 0.004, 0.006
 
 
 def _pen_holder(p: PartBuilder) -> None:
-    p.cylinder(HOLDER_R, HOLDER_FLOOR / 2, [0, 0, HOLDER_FLOOR / 2], name="floor")
-    p.ring(HOLDER_R - HOLDER_T, HOLDER_H - HOLDER_FLOOR, HOLDER_T, segments=16, z0=HOLDER_FLOOR)
+    p.open_cylinder(HOLDER_R, HOLDER_H, HOLDER_T, HOLDER_FLOOR)
 
 
 _HOLDER_RIM_R = HOLDER_R - HOLDER_T / 2
-CATALOG.add(ObjectType(
+CATALOG.add_type(ObjectType(
     name="pen_holder", category="container", description="a cylindrical desk pen holder",
     size=(2 * HOLDER_R, 2 * HOLDER_R, HOLDER_H), mass=0.12,
     colors={"black": (0.15, 0.15, 0.16, 1.0), "silver": (0.72, 0.73, 0.76, 1.0),
             "blue": (0.2, 0.35, 0.7, 1.0)},
     build=_pen_holder, tags=frozenset({"container", "graspable", "office"}),
     annotations=Annotations(
-        grasps=tuple(
-            Grasp("rim" if i == 0 else f"rim_{i}",
-                  (_HOLDER_RIM_R * math.cos(a), _HOLDER_RIM_R * math.sin(a), HOLDER_H - RIM_DROP),
-                  yaw=a + HALF_PI, width=HOLDER_T)
-            for i, a in enumerate((0.0, HALF_PI, math.pi, -HALF_PI))
-        ),
-        placements=(Placement("inside", "in", (0, 0, HOLDER_FLOOR), ((HOLDER_R - HOLDER_T) * INV_SQRT2,) * 2,
+        grasps=rim_grasps(_HOLDER_RIM_R, HOLDER_H - RIM_DROP, FOUR_SIDES, HOLDER_T),
+        # S2 is math.sqrt(0.5), one ulp above the containers' 1 / math.sqrt(2): kept, so the
+        # half size (and every scene placed in a pen holder) stays as it was.
+        placements=(Placement("inside", "in", (0, 0, HOLDER_FLOOR), ((HOLDER_R - HOLDER_T) * S2,) * 2,
                               HOLDER_H - HOLDER_FLOOR),),
     ),
 ))
@@ -454,13 +448,13 @@ def _remote(p: PartBuilder) -> None:
                   (0.55, 0.56, 0.58, 1.0), name=f"key{i}{j + 1}", **VISUAL)
 
 
-CATALOG.add(ObjectType(
+CATALOG.add_type(ObjectType(
     name="remote", category="electronics", description="a TV remote control",
     size=(REMOTE[0], REMOTE[1], REMOTE[2] + 0.001), mass=0.1,
     colors={"black": (0.12, 0.12, 0.13, 1.0), "gray": (0.45, 0.46, 0.48, 1.0),
             "white": (0.9, 0.9, 0.9, 1.0)},
     build=_remote, tags=frozenset({"graspable", "electronics", "household"}),
-    annotations=Annotations(grasps=_pair("top", (0, 0, 0.02), REMOTE[0], yaw=HALF_PI, second=math.pi)),
+    annotations=Annotations(grasps=grasp_pair("top", (0, 0, 0.02), REMOTE[0], yaw=HALF_PI, second=math.pi)),
 ))
 
 # --- glue stick ---------------------------------------------------------------------------------
@@ -474,11 +468,11 @@ def _glue_stick(p: PartBuilder) -> None:
     p.cylinder(GLUE_R + 0.0003, 0.015, [0, 0, body_h * 0.5], name="label", **VISUAL)
 
 
-CATALOG.add(ObjectType(
+CATALOG.add_type(ObjectType(
     name="glue_stick", category="office", description="a glue stick standing upright",
     size=(2 * GLUE_R + 0.001, 2 * GLUE_R + 0.001, GLUE_H), mass=0.03,
     colors={"purple": (0.55, 0.25, 0.7, 1.0), "orange": (0.95, 0.5, 0.1, 1.0),
             "green": (0.25, 0.65, 0.3, 1.0)},
     build=_glue_stick, tags=frozenset({"graspable", "office", "cylindrical"}),
-    annotations=Annotations(grasps=_pair("top", (0, 0, 0.06), 2 * GLUE_R + 0.001)),
+    annotations=Annotations(grasps=grasp_pair("top", (0, 0, 0.06), 2 * GLUE_R + 0.001)),
 ))

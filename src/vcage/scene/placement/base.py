@@ -173,7 +173,7 @@ def draw_distractors(layout: LayoutSpec, rng: np.random.Generator) -> list[Layou
     if spec.count == 0:
         return []
     own = {o.type for o in layout.objects}
-    pool = [t for t in CATALOG.all() if _eligible(t, spec.categories, spec.tags, spec.max_size)
+    pool = [t for t in CATALOG.values() if _eligible(t, spec.categories, spec.tags, spec.max_size)
             and t.name not in own and t.name not in spec.exclude]
     if not pool:
         raise PlacementError(f"no catalog type fits the distractor filter (categories "

@@ -5,7 +5,7 @@ from __future__ import annotations
 from typing import Any
 
 from vcage.sim.world import World
-from vcage.skills.primitives import Skills
+from vcage.skills.base import Skills
 from vcage.tasks import predicates as P
 from vcage.tasks.base import TASKS, AtomicTask, Item
 

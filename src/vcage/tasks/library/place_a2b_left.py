@@ -8,7 +8,7 @@ import numpy as np
 
 from vcage.scene.layout import Region, Relation, ReservedZone
 from vcage.sim.world import World
-from vcage.skills.primitives import Skills
+from vcage.skills.base import Skills
 from vcage.tasks import predicates as P
 from vcage.tasks.base import TASKS, AtomicTask, Item
 

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from vcage.planning.schema import Predicate
-from vcage.skills.primitives import Skills
+from vcage.skills.base import Skills
 from vcage.tasks.base import TASKS, AtomicTask, Item, pred
 
 
