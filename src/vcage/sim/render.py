@@ -51,6 +51,22 @@ class Renderer:
             raise ConfigError(f"unknown camera {camera!r}; cameras: {sorted(self._cameras)}")
         return self._renderer
 
+    def _orthographic(self, camera: str) -> bool:
+        self._check(camera)
+        model = self.world.model
+        projection = int(model.cam_projection[model.camera(camera).id])
+        return projection == int(mujoco.mjtProjection.mjPROJ_ORTHOGRAPHIC)
+
+    def _render(self, camera: str, mode: str) -> np.ndarray:
+        """A frame in ``mode`` (``depth`` or ``segmentation``), switched back to RGB afterwards."""
+        r = self._check(camera)
+        getattr(r, f"enable_{mode}_rendering")()
+        try:
+            r.update_scene(self.world.data, camera=camera)
+            return r.render()
+        finally:
+            getattr(r, f"disable_{mode}_rendering")()
+
     def rgb(self, camera: str) -> np.ndarray:
         r = self._check(camera)
         r.update_scene(self.world.data, camera=camera)
@@ -58,38 +74,21 @@ class Renderer:
 
     def depth(self, camera: str) -> np.ndarray:
         """Distance along the view axis in metres, from a perspective camera."""
-        r = self._check(camera)
-        model = self.world.model
-        if int(model.cam_projection[model.camera(camera).id]) != int(mujoco.mjtProjection.mjPROJ_PERSPECTIVE):
+        if self._orthographic(camera):
             # mujoco.Renderer linearises depth assuming a perspective projection.
             raise ConfigError(f"depth is only available from perspective cameras, not {camera!r}")
-        r.enable_depth_rendering()
-        try:
-            r.update_scene(self.world.data, camera=camera)
-            depth = r.render()
-        finally:
-            r.disable_depth_rendering()
-        return depth.astype(np.float32)
+        return self._render(camera, "depth").astype(np.float32)
 
     def pixel_size(self, camera: str) -> float | None:
         """Metres per pixel of an orthographic camera (its ``fovy`` is the view's height in
         metres); None for a perspective camera, whose scale varies with depth."""
-        self._check(camera)
-        model = self.world.model
-        cid = model.camera(camera).id
-        if int(model.cam_projection[cid]) != int(mujoco.mjtProjection.mjPROJ_ORTHOGRAPHIC):
+        if not self._orthographic(camera):
             return None
-        return float(model.cam_fovy[cid]) / self.height
+        return float(self.world.model.cam_fovy[self.world.model.camera(camera).id]) / self.height
 
     def segmentation(self, camera: str) -> np.ndarray:
         """Per-pixel object index into ``world.object_names``; :data:`ROBOT` for the robot, else -1."""
-        r = self._check(camera)
-        r.enable_segmentation_rendering()
-        try:
-            r.update_scene(self.world.data, camera=camera)
-            seg = r.render()
-        finally:
-            r.disable_segmentation_rendering()
+        seg = self._render(camera, "segmentation")
         ids, types = seg[..., 0], seg[..., 1]
         out = np.full(ids.shape, -1, dtype=np.int32)
         is_geom = (types == int(mujoco.mjtObj.mjOBJ_GEOM)) & (ids >= 0)
