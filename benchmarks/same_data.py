@@ -1,0 +1,92 @@
+"""Does a change leave the data alone? Generate the same datasets with two revisions and compare.
+
+Each revision's ``src/`` is exported with ``git archive`` and run through its own command line
+(``python -m vcage.cli generate ...``) in this environment; the datasets are then compared file by
+file: every data parquet, episodes parquet, video, states file and the attempt log must be
+byte-identical (the extras and meta JSON hold the configuration, whose shape may change).
+
+    .venv/bin/python benchmarks/same_data.py --before 636fa76 --after HEAD
+
+Prints one line per compared file and a summary; exits 1 if any file differs.
+"""
+
+from __future__ import annotations
+
+import argparse
+import filecmp
+import os
+import subprocess
+import sys
+import tarfile
+import tempfile
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+# (name, arguments of `vcage generate`): both revisions must accept them
+RUNS = (
+    ("vcage", ["get ready for work", "--episodes", "2", "--seed", "0"]),
+    ("vanilla", ["get ready for work", "--episodes", "2", "--seed", "0", "--mode", "vanilla"]),
+    ("oracle", ["put the mouse on the mouse pad, then press the bell", "--episodes", "1",
+                "--seed", "3", "--critic", "oracle"]),
+)
+COMPARED = ("*.parquet", "*.mp4", "*.npz", "vcage_attempts.jsonl")
+
+
+def export(rev: str, into: Path) -> Path:
+    """``src/`` of revision ``rev`` under ``into``."""
+    archive = subprocess.run(["git", "-C", str(ROOT), "archive", rev, "src"], check=True,
+                             capture_output=True).stdout
+    tar = into / "src.tar"
+    tar.write_bytes(archive)
+    with tarfile.open(tar) as t:
+        t.extractall(into, filter="data")
+    return into / "src"
+
+
+def generate(src: Path, out: Path) -> None:
+    env = {**os.environ, "PYTHONPATH": str(src)}
+    for name, args in RUNS:
+        done = subprocess.run([sys.executable, "-m", "vcage.cli", "generate", *args, "--out",
+                               str(out / name)], env=env, capture_output=True, text=True)
+        if done.returncode != 0:
+            raise SystemExit(f"{src}: generate {name} failed:\n{done.stdout}\n{done.stderr}")
+
+
+def compare(a: Path, b: Path) -> tuple[int, int]:
+    """(files compared, files that differ or are missing on one side)."""
+    compared = differ = 0
+    for name, _ in RUNS:
+        files = sorted({p.relative_to(a / name) for pattern in COMPARED for p in (a / name).rglob(pattern)})
+        other = sorted({p.relative_to(b / name) for pattern in COMPARED for p in (b / name).rglob(pattern)})
+        if files != other:
+            print(f"{name}: different files: {sorted(set(files) ^ set(other))}")
+            differ += 1
+        for rel in files:
+            same = (b / name / rel).is_file() and filecmp.cmp(a / name / rel, b / name / rel, shallow=False)
+            print(f"{'same' if same else 'DIFF'} {name}/{rel}")
+            compared += 1
+            differ += not same
+    return compared, differ
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--before", required=True, help="git revision of the reference")
+    parser.add_argument("--after", default="HEAD", help="git revision to check (default HEAD)")
+    args = parser.parse_args()
+    with tempfile.TemporaryDirectory(prefix="vcage-same-data-") as tmp:
+        root = Path(tmp)
+        outs = []
+        for label, rev in (("before", args.before), ("after", args.after)):
+            (root / label).mkdir()
+            generate(export(rev, root / label), root / label / "out")
+            outs.append(root / label / "out")
+        compared, differ = compare(*outs)
+    verdict = "all identical" if not differ else f"{differ} differ"
+    print(f"{compared} files compared, {verdict}: {args.before} vs {args.after} "
+          f"(runs: {', '.join(name for name, _ in RUNS)})")
+    raise SystemExit(1 if differ else 0)
+
+
+if __name__ == "__main__":
+    main()
