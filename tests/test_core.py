@@ -44,3 +44,13 @@ def test_sim_config_requires_whole_substeps() -> None:
     assert SimConfig().substeps == 25
     with pytest.raises(ConfigError):
         SimConfig(timestep=0.003, control_hz=20.0)
+
+
+def test_the_public_api_resolves_every_name_it_lists() -> None:
+    import vcage
+
+    for name in vcage.__all__:
+        assert getattr(vcage, name) is not None, name
+    assert "generate" in dir(vcage)
+    with pytest.raises(AttributeError, match="no attribute 'nope'"):
+        vcage.nope  # noqa: B018
