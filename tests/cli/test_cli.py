@@ -38,7 +38,9 @@ def test_generate_inspect_audit_and_a_refused_append(tmp_path: Path) -> None:
     made = RUN.invoke(app, ["generate", "press the bell", "--episodes", "1", "--out", str(out), *SMALL])
     assert made.exit_code == 0, made.output
     assert "accepted 1/1 episodes" in text(made) and "per core-hour" in text(made)
-    assert json.loads((out / "stats.json").read_text())["accepted"] == 1
+    runs = (out / "meta" / "vcage_runs.jsonl").read_text().splitlines()
+    assert len(runs) == 1 and json.loads(runs[0])["accepted"] == 1
+    assert "holds 1 episodes" in text(made)
     inspected = RUN.invoke(app, ["inspect", str(out)])
     assert inspected.exit_code == 0 and "1 episodes" in text(inspected)
     audited = RUN.invoke(app, ["audit", str(out)])
