@@ -78,12 +78,39 @@ class BackendTimeout(BackendError):  # noqa: N818 - the name says what happened
     """A model provider did not answer within the configured timeout on any attempt."""
 
 
+class BackendUnavailableError(BackendError):
+    """A model endpoint cannot be reached or will not answer: connection refused, timeouts, 429 or 5xx
+    after every retry, 401/403/404 (no retry fixes them), an open circuit breaker or a failed preflight.
+
+    An outage, never a model's verdict: stop the run, fix the endpoint (the message says which, with
+    the model, the HTTP status and the server's own message) and run again.
+    """
+
+
+class BackendUnavailableTimeout(BackendUnavailableError, BackendTimeout):  # noqa: N818 - as BackendTimeout
+    """The endpoint did not answer within the timeout on any attempt: an outage and a timeout both."""
+
+
+class EmptyReplyError(BackendError):
+    """The server answered, but its reply holds no text (e.g. a refusal or a blocked candidate).
+
+    A reply, not an outage: a critic counts it as a malformed answer.
+    """
+
+
 class MissingAPIKeyError(ConfigError):
     """No API key is configured for a remote endpoint; the message names the env var and config field."""
 
 
 class DatasetError(VcageError):
     """A dataset cannot be written or read as asked: mismatched config, bad input or a corrupt file."""
+
+
+class CorruptDatasetError(DatasetError):
+    """A dataset's files are damaged (truncated, unreadable, missing or inconsistent with its metadata).
+
+    The message names the files and episodes; ``vcage verify DATASET --repair`` drops a damaged tail.
+    """
 
 
 class PlanningError(VcageError):

@@ -17,7 +17,9 @@ Each ``POST /v1/chat/completions`` consumes the next scripted item: a reply text
 :class:`Reply`), an HTTP error in OpenAI's error format (:class:`Status`), a :class:`Delay` (sleep,
 then answer with its ``then`` item, usually after the client gave up), or a callable that receives the
 request body and returns one of those. An empty script answers 500 with a message saying so.
-``GET /v1/models`` lists the served model.
+``GET /v1/models`` lists the served models (``server.models``, by default the one it was made with);
+``server.gets`` holds the paths of GET requests, and ``server.listing_error`` (a :class:`Status` or
+:class:`Delay`) makes every GET answer with it instead.
 """
 
 from __future__ import annotations
@@ -73,6 +75,9 @@ class FakeOpenAI:
 
     def __init__(self, model: str = "fake-model") -> None:
         self.model = model
+        self.models: list[str] = [model]  # what GET /v1/models lists
+        self.listing_error: Status | Delay | None = None  # answer every GET with this instead
+        self.gets: list[str] = []  # paths of GET requests, in arrival order
         self.requests: list[dict[str, Any]] = []  # request bodies, in arrival order
         self.headers: list[dict[str, str]] = []  # request headers, same order
         self._script: deque[Item] = deque()
@@ -134,8 +139,12 @@ class FakeOpenAI:
         """The answer to ``GET path``, or None for 404."""
         if path.rstrip("/") != "/v1/models":
             return None
-        data = [{"id": self.model, "object": "model", "created": 0, "owned_by": "fake-openai"}]
+        data = [{"id": m, "object": "model", "created": 0, "owned_by": "fake-openai"} for m in self.models]
         return {"object": "list", "data": data}
+
+    def not_found(self, method: str, path: str) -> str:
+        """The message of a 404 for ``method path``."""
+        return f"no route {method} {path}"
 
     def success(self, path: str, body: dict[str, Any], reply: Reply) -> dict[str, Any]:
         return completion(str(body.get("model", self.model)), reply)
@@ -172,9 +181,14 @@ def _handler_class(server: FakeOpenAI) -> type[BaseHTTPRequestHandler]:
             pass
 
         def do_GET(self) -> None:  # noqa: N802 - http.server naming
+            with server._lock:
+                server.gets.append(self.path)
+            if server.listing_error is not None:
+                self._answer(server.listing_error, {})
+                return
             listing = server.listing(self.path)
             if listing is None:
-                self._send(404, server.error(404, f"no route GET {self.path}"))
+                self._send(404, server.error(404, server.not_found("GET", self.path)))
             else:
                 self._send(200, listing)
 

@@ -7,6 +7,7 @@ import io
 import json
 import subprocess
 import sys
+import time
 from collections.abc import Iterator
 from typing import Any
 
@@ -17,7 +18,14 @@ from PIL import Image
 from vcage.backends import BackendConfig, ChatBackend, Message, connect
 from vcage.critics.base import Observation, View
 from vcage.critics.vlm import VLMCritic
-from vcage.errors import BackendError, BackendTimeout, ConfigError, MissingAPIKeyError
+from vcage.errors import (
+    BackendError,
+    BackendTimeout,
+    BackendUnavailableError,
+    ConfigError,
+    EmptyReplyError,
+    MissingAPIKeyError,
+)
 from vcage.planning.goals import put_on
 from vcage.planning.llm import LLMPlanner
 
@@ -91,7 +99,7 @@ def test_malformed_content_returned_as_is_and_empty_content_raises(server: FakeG
     server.script("Sure! {not json", Reply(None))
     b = backend(server)
     assert b.chat([Message("user", "plan")], json_mode=True) == "Sure! {not json"
-    with pytest.raises(BackendError, match="no message content"):
+    with pytest.raises(EmptyReplyError, match="no message content"):
         b.chat([Message("user", "plan")])
 
 
@@ -110,6 +118,7 @@ def test_persistent_503_raises_after_all_retries(server: FakeGemini) -> None:
         b.chat([Message("user", "hi")])
     err = info.value
     assert not isinstance(err, BackendTimeout) and err.status == 503 and err.model == "gemini-test"
+    assert isinstance(err, BackendUnavailableError)
     assert "HTTP 503: model overloaded" in str(err) and "3 attempts" in str(err)
     assert len(server.requests) == 3
 
@@ -132,7 +141,7 @@ def test_400_fails_at_once_naming_the_problem(server: FakeGemini) -> None:
 def test_connection_refused_is_backend_error() -> None:
     with FakeGemini() as stopped:
         pass
-    with pytest.raises(BackendError, match="connection failed"):
+    with pytest.raises(BackendUnavailableError, match="connection failed"):
         backend(stopped, max_retries=0).chat([Message("user", "hi")])
 
 
@@ -164,6 +173,80 @@ def test_llm_planner_and_vlm_critic_through_gemini(server: FakeGemini) -> None:
     obs = Observation(subtask=put_on("mouse", "pad", "the mouse lies on the pad"), labels=("mouse", "pad"),
                       before=views, after=views)
     assert VLMCritic(backend(server)).judge(obs).accept
+
+
+def _obs() -> Observation:
+    img = np.zeros((24, 32, 3), np.uint8)
+    seg = np.full((24, 32), -1, np.int32)
+    views = {"top": View(img, seg), "front": View(img, seg)}
+    return Observation(subtask=put_on("mouse", "pad", "the mouse lies on the pad"), labels=("mouse", "pad"),
+                       before=views, after=views)
+
+
+GEMINI_OUTAGES = {
+    # name: (script, retries, requests the server sees, text the error must carry)
+    "http-503": ([Status(503, "The model is overloaded")] * 2, 1, 2, ["HTTP 503", "The model is overloaded"]),
+    "http-429": ([Status(429, "quota exceeded", retry_delay="0.05s")] * 2, 1, 2,
+                 ["HTTP 429", "quota exceeded"]),
+    "http-401": ([Status(401, "API key not valid")], 2, 1,
+                 ["HTTP 401", "API key not valid", "GEMINI_API_KEY"]),
+    "stalled": ([Delay(5.0)] * 2, 1, 2, ["timed out after 2 attempts"]),
+}
+
+
+@pytest.mark.parametrize("case", sorted(GEMINI_OUTAGES))
+def test_vlm_critic_raises_on_a_gemini_outage(server: FakeGemini, case: str) -> None:
+    script, retries, seen, texts = GEMINI_OUTAGES[case]
+    server.script(*script)
+    critic = VLMCritic(backend(server, timeout=0.3, max_retries=retries))
+    t0 = time.monotonic()
+    with pytest.raises(BackendUnavailableError) as info:
+        critic.judge(_obs())
+    assert time.monotonic() - t0 < 10.0
+    endpoint = server.base_url + "/v1beta/models/gemini-test:generateContent"
+    assert info.value.endpoint == endpoint and endpoint in str(info.value)
+    for text in texts:
+        assert text in str(info.value)
+    assert len(server.requests) == seen
+
+
+def test_vlm_critic_raises_when_nothing_listens_on_gemini_port() -> None:
+    with FakeGemini() as stopped:
+        pass
+    with pytest.raises(BackendUnavailableError, match="connection failed"):
+        VLMCritic(backend(stopped, max_retries=1)).judge(_obs())
+
+
+def test_gemini_breaker_fails_fast_and_malformed_stays_a_vote(server: FakeGemini) -> None:
+    server.script("no json here", Status(500, "internal"), "never sent")
+    critic = VLMCritic(backend(server, max_retries=0, breaker_failures=1))
+    verdict = critic.judge(_obs())
+    assert not verdict.accept and verdict.details["malformed"] == 1
+    with pytest.raises(BackendUnavailableError, match="HTTP 500: internal"):
+        critic.judge(_obs())
+    with pytest.raises(BackendUnavailableError, match="circuit open after 1 consecutive failures"):
+        critic.judge(_obs())
+    assert len(server.requests) == 2 and server.remaining == 1
+
+
+def test_gemini_preflight_healthy_unknown_model_and_closed_port(server: FakeGemini) -> None:
+    server.models = ["gemini-test"]
+    VLMCritic(backend(server)).preflight()
+    assert server.gets == ["/v1beta/models/gemini-test"] and server.requests == []
+    server.models = ["gemini-2.5-flash", "gemini-2.5-pro"]
+    with pytest.raises(BackendUnavailableError) as info:
+        backend(server).preflight()
+    assert str(info.value).startswith(
+        f"model 'gemini-test' is not served at {server.base_url}; served: gemini-2.5-flash, gemini-2.5-pro.")
+    server.listing_error = Status(403, "API key not valid for this project")
+    with pytest.raises(BackendUnavailableError, match="HTTP 403: API key not valid") as info:
+        backend(server, max_retries=3).preflight()
+    assert f"preflight request to {server.base_url}/v1beta/models/gemini-test " in str(info.value)
+    assert server.requests == []
+    with FakeGemini() as stopped:
+        pass
+    with pytest.raises(BackendUnavailableError, match="connection failed"):
+        backend(stopped, max_retries=3).preflight()
 
 
 def test_gemini_sdk_is_imported_only_when_used() -> None:

@@ -7,6 +7,7 @@ import io
 import json
 import subprocess
 import sys
+import threading
 from collections.abc import Iterator
 from typing import Any
 
@@ -15,7 +16,16 @@ import pytest
 from PIL import Image
 
 from vcage.backends import BACKENDS, BackendConfig, ChatBackend, Message, OpenAIChatBackend, make_backend
-from vcage.errors import BackendError, BackendTimeout, ConfigError, MissingAPIKeyError, RegistryError
+from vcage.backends.retry import Failure
+from vcage.errors import (
+    BackendError,
+    BackendTimeout,
+    BackendUnavailableError,
+    ConfigError,
+    EmptyReplyError,
+    MissingAPIKeyError,
+    RegistryError,
+)
 
 from .fake_openai import Delay, FakeOpenAI, Reply, Status
 
@@ -112,8 +122,9 @@ def test_malformed_content_returned_as_is(server: FakeOpenAI) -> None:
 
 def test_missing_content_raises(server: FakeOpenAI) -> None:
     server.script(Reply(None))
-    with pytest.raises(BackendError, match="no message content"):
+    with pytest.raises(EmptyReplyError, match="no message content") as info:
         backend(server).chat([Message("user", "plan")])
+    assert not isinstance(info.value, BackendUnavailableError)  # the server answered
 
 
 def test_429_then_success_retries_once_honouring_retry_after(server: FakeOpenAI) -> None:
@@ -137,7 +148,7 @@ def test_persistent_500_raises_after_all_retries(server: FakeOpenAI) -> None:
     with pytest.raises(BackendError) as info:
         b.chat([Message("user", "hi")])
     err = info.value
-    assert not isinstance(err, BackendTimeout)
+    assert not isinstance(err, BackendTimeout) and isinstance(err, BackendUnavailableError)
     assert err.status == 500 and err.model == "qwen2.5-vl"
     assert err.endpoint == server.base_url + "/chat/completions"
     assert "HTTP 500" in str(err) and "model crashed" in str(err) and err.endpoint in str(err)
@@ -149,8 +160,9 @@ def test_persistent_500_raises_after_all_retries(server: FakeOpenAI) -> None:
 def test_timeout_raises_backend_timeout_after_retries(server: FakeOpenAI) -> None:
     server.script(Delay(2.0), Delay(2.0))
     b = backend(server, timeout=0.15, max_retries=1)
-    with pytest.raises(BackendTimeout, match="timed out after 2 attempts"):
+    with pytest.raises(BackendTimeout, match="timed out after 2 attempts") as info:
         b.chat([Message("user", "hi")])
+    assert isinstance(info.value, BackendUnavailableError)  # a timeout is an outage too
     assert len(server.requests) == 2 and b.usage.retries == 1
 
 
@@ -159,7 +171,7 @@ def test_400_fails_without_retry(server: FakeOpenAI) -> None:
     b = backend(server)
     with pytest.raises(BackendError, match="HTTP 400: response_format json_object") as info:
         b.chat([Message("user", "hi")], json_mode=True)
-    assert info.value.status == 400
+    assert info.value.status == 400 and not isinstance(info.value, BackendUnavailableError)
     assert len(server.requests) == 1 and b.usage.retries == 0 and server.remaining == 1
 
 
@@ -167,7 +179,7 @@ def test_connection_refused_is_backend_error() -> None:
     with FakeOpenAI() as stopped:
         pass
     b = backend(stopped, max_retries=1)  # nothing listens on its port any more
-    with pytest.raises(BackendError, match="connection failed"):
+    with pytest.raises(BackendUnavailableError, match="connection failed"):
         b.chat([Message("user", "hi")])
     assert b.usage.requests == 2
 
@@ -206,7 +218,9 @@ def test_env_key_is_sent(server: FakeOpenAI, monkeypatch: pytest.MonkeyPatch) ->
 @pytest.mark.parametrize(
     ("field", "value"),
     [("model", ""), ("timeout", 0.0), ("timeout", -1.0), ("max_retries", -1), ("base_url", "ftp://host/v1"),
-     ("base_url", "localhost:8000/v1"), ("backoff", -0.1), ("temperature", 3.0), ("max_tokens", 0)],
+     ("base_url", "localhost:8000/v1"), ("backoff", -0.1), ("temperature", 3.0), ("max_tokens", 0),
+     ("breaker_failures", 0), ("breaker_failures", True), ("breaker_failures", 2.0),
+     ("max_backoff", float("inf"))],
 )
 def test_config_validation_names_field(field: str, value: Any) -> None:
     data: dict[str, Any] = {"base_url": "http://localhost:8000/v1", "model": "m", field: value}
@@ -222,6 +236,65 @@ def test_to_dict_has_no_secret_and_round_trips() -> None:
     assert BackendConfig.from_dict(data) == cfg
     with pytest.raises(ConfigError, match="valid keys"):
         BackendConfig.from_dict({**data, "modle": "x"})
+
+
+def test_reliability_settings_round_trip_and_are_used(server: FakeOpenAI) -> None:
+    cfg = config(server, timeout=0.25, max_retries=1, backoff=0.03, max_backoff=0.04, breaker_failures=2)
+    data = cfg.to_dict()
+    assert {k: data[k] for k in ("timeout", "max_retries", "backoff", "max_backoff", "breaker_failures")} == {
+        "timeout": 0.25, "max_retries": 1, "backoff": 0.03, "max_backoff": 0.04, "breaker_failures": 2}
+    assert BackendConfig.from_dict(json.loads(json.dumps(data))) == cfg
+    older = {k: v for k, v in data.items() if k != "breaker_failures"}  # written before the field existed
+    assert BackendConfig.from_dict(older).breaker_failures == 3
+    server.script(Status(500), Status(500), Delay(2.0), Delay(2.0), "never sent")
+    with make_backend("openai", cfg) as b:
+        with pytest.raises(BackendUnavailableError, match="HTTP 500"):
+            b.chat([Message("user", "hi")])
+        assert (b.usage.requests, b.usage.wait_s) == (2, pytest.approx(0.03))  # max_retries, backoff
+        with pytest.raises(BackendTimeout, match=r"timeout 0.25 s each"):
+            b.chat([Message("user", "hi")])
+        assert b.usage.wait_s == pytest.approx(0.03 + 0.03)  # second request: same first wait
+        with pytest.raises(BackendUnavailableError, match="circuit open after 2 consecutive"):
+            b.chat([Message("user", "hi")])
+        assert len(server.requests) == 4 and server.remaining == 1
+
+
+def test_failures_that_mean_the_endpoint_is_unavailable() -> None:
+    unavailable = [Failure(retry=True, detail="timed out", timed_out=True),
+                   Failure(retry=True, detail="connection failed"),
+                   *(Failure.http(s, "x") for s in (401, 403, 404, 429, 500, 502, 503, 504))]
+    answered = [Failure(retry=False, detail="APIResponseValidationError"),
+                *(Failure.http(s, "x") for s in (400, 409, 413, 422))]
+    assert all(f.unavailable for f in unavailable)
+    assert not any(f.unavailable for f in answered)
+
+
+def test_breaker_counts_concurrent_failures_exactly(server: FakeOpenAI) -> None:
+    server.script(*[Status(500)] * 8)
+    b = backend(server, max_retries=0, breaker_failures=9)
+    errors: list[Exception] = []
+
+    def ask() -> None:
+        try:
+            b.chat([Message("user", "hi")])
+        except BackendError as exc:
+            errors.append(exc)
+
+    threads = [threading.Thread(target=ask) for _ in range(8)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert len(errors) == 8 and b.breaker.failures == 8 and not b.breaker.is_open
+    server.script(Status(500), "never sent")
+    with pytest.raises(BackendUnavailableError, match="HTTP 500"):
+        b.chat([Message("user", "hi")])
+    assert b.breaker.is_open
+    with pytest.raises(BackendUnavailableError, match="circuit open after 9"):
+        b.chat([Message("user", "hi")])
+    assert len(server.requests) == 9 and b.usage.requests == 9
+    b.reset()
+    assert b.chat([Message("user", "hi")]) == "never sent" and b.breaker.failures == 0
 
 
 def test_from_env() -> None:

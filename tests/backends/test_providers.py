@@ -54,6 +54,8 @@ def test_one_registration_makes_config_env_defaults_and_connect_work() -> None:
     with connect(cfg) as backend:
         assert isinstance(backend, Canned) and backend.chat([Message("user", "hi")]) == "canned reply"
         assert backend.usage.requests == 1
+        backend.preflight()  # a provider without a probe has nothing to check and sends nothing
+        assert backend.usage.requests == 1
     with pytest.raises(RegistryError, match="already registered"):
         add_provider(Provider(name, base_url="http://localhost:1", api_key_env="X", factory=Canned))
 

@@ -5,7 +5,8 @@
 reads the ``VCAGE_LLM_*`` / ``VCAGE_VLM_*`` variables.
 
 Modules: ``messages`` (Message, PNG encoding), ``config`` (BackendConfig), ``usage`` (Usage),
-``retry`` (Failure, Retry-After, the retry loop), ``base`` (ChatBackend), ``providers`` (the one
+``retry`` (Failure, Retry-After, the retry loop, the circuit breaker), ``base`` (ChatBackend: chat,
+preflight, reset), ``providers`` (the one
 provider registry, ``connect``), ``builtin`` (registers openai and gemini), and one module per
 provider's SDK (``openai_compat``, ``gemini``).
 """

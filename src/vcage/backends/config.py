@@ -26,7 +26,11 @@ class BackendConfig:
 
     ``api_key`` wins over the environment variable named by ``api_key_env``; local servers
     (localhost, 127.0.0.1, ::1) need neither. ``max_backoff`` caps every wait between retries,
-    including waits a server asks for with ``Retry-After``.
+    including waits a server asks for with ``Retry-After``. One request therefore takes at most
+    ``timeout * (1 + max_retries)`` seconds plus the waits (each ``min(max_backoff, backoff * 2**n)``,
+    or the server's ``Retry-After`` capped by ``max_backoff``). After ``breaker_failures`` requests
+    in a row have failed that way, the backend's circuit opens and further requests fail at once
+    with :class:`~vcage.errors.BackendUnavailableError` until ``reset()``.
     """
 
     base_url: str
@@ -38,6 +42,7 @@ class BackendConfig:
     max_retries: int = 3  # retries after the first attempt
     backoff: float = 0.5  # seconds; wait before retry n is backoff * 2**n
     max_backoff: float = 10.0  # seconds
+    breaker_failures: int = 3  # failed requests in a row (after their retries) that open the circuit
     temperature: float = 0.0
     max_tokens: int | None = 1024
 
@@ -62,6 +67,9 @@ class BackendConfig:
         retries = self.max_retries
         if isinstance(retries, bool) or not isinstance(retries, int) or retries < 0:
             raise ConfigError(f"max_retries must be an integer >= 0, got {self.max_retries!r}")
+        breaker = self.breaker_failures
+        if isinstance(breaker, bool) or not isinstance(breaker, int) or breaker < 1:
+            raise ConfigError(f"breaker_failures must be an integer >= 1, got {self.breaker_failures!r}")
         if self.max_tokens is not None and (
             isinstance(self.max_tokens, bool) or not isinstance(self.max_tokens, int) or self.max_tokens < 1
         ):

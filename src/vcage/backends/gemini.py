@@ -4,6 +4,7 @@ System messages become the request's system instruction, assistant messages the 
 and images inline PNG parts. As for the OpenAI-compatible backend, retries are done by
 :class:`ChatBackend` (the SDK's own are switched off): timeouts, connection errors, 429 and 5xx are
 retried with backoff or the wait the server asks for (``Retry-After`` or the error's ``RetryInfo``).
+``preflight`` asks ``models.get`` for the configured model (and, if it is not found, which are).
 """
 
 from __future__ import annotations
@@ -71,8 +72,29 @@ it is used.
     def endpoint(self) -> str:
         return f"{self.config.base_url.rstrip('/')}/{API_VERSION}/models/{self.config.model}:generateContent"
 
+    @property
+    def probe_url(self) -> str:
+        return f"{self.config.base_url.rstrip('/')}/{API_VERSION}/models/{self.config.model}"
+
     def close(self) -> None:
         self._client.close()
+
+    def _probe(self) -> list[str] | None:
+        """``models.get(model)``; if the model is not found, the names the server lists instead."""
+        try:
+            self._client.models.get(model=self.config.model)
+        except errors.APIError as exc:
+            if exc.code != 404:
+                raise
+            try:
+                listed = self._client.models.list(config={"page_size": 100}).page
+            except (errors.APIError, httpx2.HTTPError):
+                raise exc from None
+            served = [m.name.removeprefix("models/") for m in listed if m.name]
+            if not served or self._serves(served):
+                raise  # the listing does not explain the 404: report it as it is
+            return served
+        return None
 
     def chat(self, messages: Sequence[Message], *, json_mode: bool = False) -> str:
         system, turns = contents(messages)

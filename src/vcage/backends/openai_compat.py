@@ -2,7 +2,8 @@
 
 Retries are done by :class:`ChatBackend`, not by the SDK, so they are counted and bounded: timeouts,
 connection errors, 429 and 5xx are retried with exponential backoff (or the server's ``Retry-After``),
-capped by ``max_backoff``; other 4xx fail at once.
+capped by ``max_backoff``; other 4xx fail at once. ``preflight`` lists ``GET {base_url}/models`` and
+checks the configured model is among them.
 """
 
 from __future__ import annotations
@@ -60,8 +61,16 @@ class OpenAIChatBackend(ChatBackend):
     def endpoint(self) -> str:
         return self.config.base_url.rstrip("/") + "/chat/completions"
 
+    @property
+    def probe_url(self) -> str:
+        return self.config.base_url.rstrip("/") + "/models"
+
     def close(self) -> None:
         self._client.close()
+
+    def _probe(self) -> list[str]:
+        """``GET {base_url}/models``: what every OpenAI-compatible server lists (vLLM, Ollama, ...)."""
+        return [m.id for m in self._client.models.list()]
 
     def chat(self, messages: Sequence[Message], *, json_mode: bool = False) -> str:
         if not messages:

@@ -58,7 +58,16 @@ class Critic(ABC):
 
     @abstractmethod
     def judge(self, obs: Observation) -> Verdict:
-        """Accept or reject the subtask's outcome."""
+        """Accept or reject the subtask's outcome.
+
+        Model-based critics raise :class:`~vcage.errors.BackendUnavailableError` when their model
+        cannot answer: an outage is never a verdict.
+        """
+
+    def preflight(self) -> None:
+        """Check, before any episode is simulated, that the critic can judge (e.g. its model endpoint
+        answers); raises :class:`~vcage.errors.BackendUnavailableError` if not. The default has
+        nothing to check."""
 
 
 @dataclass(frozen=True)
