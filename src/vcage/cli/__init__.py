@@ -10,7 +10,7 @@ from vcage.cli._app import app, console
 
 # The order of these imports is the order of the commands in `vcage --help`.
 # isort: off
-from vcage.cli import tasks, plan, generate, inspect_cmd, audit  # noqa: F401
+from vcage.cli import tasks, plan, generate, inspect_cmd, audit, verify  # noqa: F401
 from vcage.cli import export, catalog, scene, run  # noqa: F401
 # isort: on
 

@@ -2,5 +2,7 @@
 
 from vcage.data.lerobot import DatasetWriter
 from vcage.data.reader import DatasetReader, Episode, Feature
+from vcage.data.verify import Problem, RepairReport, VerifyReport, check, repair, verify
 
-__all__ = ["DatasetReader", "DatasetWriter", "Episode", "Feature"]
+__all__ = ["DatasetReader", "DatasetWriter", "Episode", "Feature", "Problem", "RepairReport", "VerifyReport",
+           "check", "repair", "verify"]

@@ -2,19 +2,19 @@
 
 Each episode gets its own data parquet and one mp4 per camera (chunk = index // chunks_size,
 file = index % chunks_size). Files are written to a temporary name and moved into place; the meta
-files follow, and rewriting ``meta/info.json`` last commits the episode. A failed episode is rolled
-back; leftovers of a crash beyond the commit point are removed when a writer reopens the dataset.
+files follow (with the dataset card ``README.md``), and rewriting ``meta/info.json`` last commits the
+episode. A failed episode is rolled back; leftovers of a crash beyond the commit point are removed
+when a writer reopens the dataset. Nothing is written before the first episode commits, and a writer
+refuses to append to a dataset whose files fail the cheap checks of :func:`vcage.data.verify.check`.
 """
 
 from __future__ import annotations
 
 import contextlib
-import fcntl
 import functools
 import io
 import json
 import os
-import re
 from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Any, cast
@@ -25,18 +25,33 @@ import pyarrow.parquet as pq
 
 from vcage.data import layout, video
 from vcage.data import stats as st
-from vcage.data.files import TMP_MARK, atomic_write, diff, tasks_table, to_json, write_json, write_table
+from vcage.data.card import dataset_card
+from vcage.data.files import (
+    TMP_MARK,
+    atomic_write,
+    diff,
+    episode_row,
+    episodes_table,
+    lock_dir,
+    remove_empty_dirs,
+    tasks_table,
+    to_json,
+    write_json,
+    write_table,
+    write_text,
+)
 from vcage.data.reader import DTYPES, STANDARD_COLUMNS, DatasetReader, Feature, load_json
-from vcage.errors import DatasetError
-
-_EPISODE_FILE = re.compile(
-    r"(?:chunk-(\d+)/file-(\d+)\.(?:parquet|mp4)|episode_(\d+)(?:_states\.npz|\.json))$")
+from vcage.data.verify import check
+from vcage.errors import CorruptDatasetError, DatasetError
 
 
 class DatasetWriter:
     """Creates a dataset at ``root``, or appends to one made with the same config, fps, features, cameras.
 
-    Holds a lock on the dataset until :meth:`close` (or the end of a ``with`` block).
+    Holds a lock on the dataset directory itself (``flock``, no lock file) until :meth:`close` (or
+    the end of a ``with`` block). A new dataset is written by its first :meth:`add_episode`: until
+    then the directory stays empty, and a writer closed without an episode removes the directory
+    (and its parents) if it created them.
     """
 
     def __init__(self, root: str | Path, *, fps: int, features: Mapping[str, Feature],
@@ -59,16 +74,41 @@ class DatasetWriter:
         self._stats: dict[str, dict[str, np.ndarray]] = {}
         self._total_episodes = self._total_frames = 0
         self._lock_fd: int | None = None
+        self._fresh = False  # the directory was absent or empty: the first episode creates the dataset
+        self._made_dirs: list[Path] = []  # the directory and parents this writer created
         if self.root.exists() and not self.root.is_dir():
             raise DatasetError(f"{self.root} is a file; choose a directory for --out")
-        if not self.root.exists() or not any(self.root.iterdir()):
-            self._create()
-        else:
-            self._open_existing()
+        parent = self.root
+        while not parent.exists():
+            self._made_dirs.append(parent)
+            parent = parent.parent
+        try:
+            self.root.mkdir(parents=True, exist_ok=True)
+            self._lock_fd = lock_dir(self.root)
+            if any(self.root.iterdir()):
+                self._open_existing()
+            else:
+                self._fresh, self._encoder = True, video.choose_encoder() if self.cameras else ""
+        except BaseException:
+            self.close()
+            raise
 
     def close(self) -> None:
-        """Release the dataset lock; every added episode is already committed."""
-        if self._lock_fd is not None:
+        """Release the dataset lock; every added episode is already committed.
+
+        A new dataset that got no episode is removed again: the directories this writer created,
+        and any empty directory a failed first episode left, so the directory is as it was found.
+        """
+        if self._lock_fd is None:
+            return
+        try:
+            if self._fresh and self._total_episodes == 0 and self.root.is_dir():
+                with contextlib.suppress(OSError):
+                    remove_empty_dirs(self.root, keep_root=self.root not in self._made_dirs)
+                for made in self._made_dirs[1:]:
+                    with contextlib.suppress(OSError):
+                        made.rmdir()  # only if empty
+        finally:
             os.close(self._lock_fd)
             self._lock_fd = None
 
@@ -81,17 +121,6 @@ class DatasetWriter:
     def __del__(self) -> None:
         with contextlib.suppress(Exception):
             self.close()
-
-    def _lock(self) -> None:
-        """Hold an exclusive lock on the dataset so that two writers never append at once."""
-        fd = os.open(self.root / layout.LOCK_PATH, os.O_RDWR | os.O_CREAT, 0o644)
-        try:
-            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except OSError:
-            os.close(fd)
-            raise DatasetError(f"another writer is appending to {self.root}; wait for it to finish or "
-                               "choose another --out directory") from None
-        self._lock_fd = fd
 
     @property
     def num_episodes(self) -> int:
@@ -112,17 +141,24 @@ class DatasetWriter:
                 "features": {k: f.to_info() for k, f in self.features.items()},
                 "cameras": {k: [h, w, 3] for k, (h, w) in self.cameras.items()}}
 
-    def _create(self) -> None:
-        self._encoder = video.choose_encoder() if self.cameras else ""
-        (self.root / "meta").mkdir(parents=True, exist_ok=True)
-        self._lock()
-        write_json(self.root / layout.VCAGE_PATH, {"format": "vcage/lerobot-v3", "config": self.config})
-        self._write_info(0, 0, 0)
-
     def _open_existing(self) -> None:
+        if self._uncommitted_first_episode():
+            self._clear_uncommitted()
+            self._fresh, self._encoder = True, video.choose_encoder() if self.cameras else ""
+            return
+        if (self.root / layout.VCAGE_PATH).is_file() and not (self.root / layout.INFO_PATH).exists():
+            raise CorruptDatasetError(
+                f"{self.root} holds {layout.VCAGE_PATH} but no {layout.INFO_PATH}: either a run was killed "
+                "before its first episode committed (delete the directory to start again) or the file was "
+                f"lost (`vcage verify {self.root} --repair` rebuilds it from {layout.VCAGE_PATH})")
         if not (self.root / layout.VCAGE_PATH).is_file() or not (self.root / layout.INFO_PATH).is_file():
             raise DatasetError(f"{self.root} is not empty and holds no vcage dataset (no {layout.VCAGE_PATH} "
                                f"and {layout.INFO_PATH}); choose another --out directory or an empty one")
+        report = check(self.root)
+        if not report.ok:
+            raise CorruptDatasetError(f"refusing to append to the damaged dataset {self.root}: "
+                                      f"{report.brief()}; run `vcage verify {self.root} --repair` to "
+                                      "drop the damaged episodes, then append")
         info = load_json(self.root / layout.INFO_PATH)
         features = info.get("features", {})
         found = {"fps": info.get("fps"), "robot_type": info.get("robot_type"),
@@ -138,7 +174,7 @@ class DatasetWriter:
                                f"({shown}); choose another --out directory, or pass the same config to "
                                "append to it")
         self._encoder = self._encoder_for(info)
-        self._lock()
+        (self.root / layout.LEGACY_LOCK_PATH).unlink(missing_ok=True)  # older writers left it
         reader = DatasetReader(self.root)
         self._tasks = list(reader.tasks)
         self._total_episodes, self._total_frames = reader.num_episodes, reader.total_frames
@@ -148,6 +184,29 @@ class DatasetWriter:
         last_chunk = (self._total_episodes - 1) // self.chunks_size
         self._chunk_rows = [r for r in rows if r["episode_index"] // self.chunks_size == last_chunk]
         self._remove_leftovers(rewrite_meta=reader._uncommitted)
+
+    def _uncommitted_first_episode(self) -> bool:
+        """Whether the directory holds only what a writer killed during its first episode leaves:
+        no ``info.json``, no episode rows, and nothing but files this writer writes."""
+        rows = (self.root / "meta" / "episodes").rglob("*.parquet")
+        if (self.root / layout.INFO_PATH).exists() or any(rows):
+            return False
+        return all(self._written_here(p) for p in self.root.rglob("*") if p.is_file())
+
+    def _written_here(self, path: Path) -> bool:
+        rel = path.relative_to(self.root).as_posix()
+        ours = [layout.VCAGE_PATH, layout.TASKS_PATH, layout.STATS_PATH, layout.LEGACY_LOCK_PATH]
+        if (self.root / layout.VCAGE_PATH).is_file():  # a README.md is the card only beside our marker
+            ours.append(layout.CARD_PATH)
+        return ((path.name.startswith(".") and TMP_MARK in path.name)
+                or layout.episode_of_file(rel, self.chunks_size) is not None or rel in ours)
+
+    def _clear_uncommitted(self) -> None:
+        """Remove what a killed first episode left, so the run starts the dataset again."""
+        for path in sorted(self.root.rglob("*"), reverse=True):
+            if path.is_file():
+                path.unlink()
+        remove_empty_dirs(self.root, keep_root=True)
 
     def _encoder_for(self, info: dict[str, Any]) -> str:
         codecs = {ft["info"]["video.codec"] for ft in info["features"].values() if ft.get("dtype") == "video"}
@@ -164,27 +223,24 @@ class DatasetWriter:
         for path in sorted(self.root.rglob("*")):
             if not path.is_file():
                 continue
-            rel = path.relative_to(self.root).as_posix()
-            match = _EPISODE_FILE.search(rel)
-            if path.name.startswith(".") and TMP_MARK in path.name:
+            index = layout.episode_of_file(path.relative_to(self.root).as_posix(), self.chunks_size)
+            temporary = path.name.startswith(".") and TMP_MARK in path.name
+            if temporary or (index is not None and index >= self._total_episodes):
                 path.unlink()
-            elif match and rel.startswith(("data/", "videos/", "extras/")):
-                chunk, file, ep = match.groups()
-                index = int(ep) if ep is not None else int(chunk) * self.chunks_size + int(file)
-                if index >= self._total_episodes:
-                    path.unlink()
         if self._total_episodes == 0:
             for path in [self.root / layout.TASKS_PATH, self.root / layout.STATS_PATH,
                          *(self.root / "meta" / "episodes").glob("chunk-*/file-*.parquet")]:
                 path.unlink(missing_ok=True)
         elif rewrite_meta:
             self._write_meta(self._tasks, self._chunk_rows, self._stats)
+            write_text(self.root / layout.CARD_PATH, self._card(self._total_episodes, self._total_frames,
+                                                                self._tasks))
             last_chunk = (self._total_episodes - 1) // self.chunks_size
             for path in (self.root / "meta" / "episodes").glob("chunk-*/file-*.parquet"):
                 if int(path.parent.name.split("-")[1]) > last_chunk:
                     path.unlink()
 
-    def _write_info(self, episodes: int, frames: int, tasks: int) -> None:
+    def _info(self, episodes: int, frames: int, tasks: int) -> dict[str, Any]:
         features: dict[str, Any] = {k: f.to_info() for k, f in self.features.items()}
         codec = video.codec_name(self._encoder) if self._encoder else None
         for key, (h, w) in self.cameras.items():
@@ -200,7 +256,21 @@ class DatasetWriter:
                 "data_files_size_in_mb": 100, "video_files_size_in_mb": 200, "fps": self.fps,
                 "splits": {"train": f"0:{episodes}"}, "data_path": layout.DATA_PATH,
                 "video_path": layout.VIDEO_PATH if self.cameras else None, "features": features}
-        write_json(self.root / layout.INFO_PATH, info)
+        return info
+
+    def _write_info(self, episodes: int, frames: int, tasks: int) -> None:
+        write_json(self.root / layout.INFO_PATH, self._info(episodes, frames, tasks))
+
+    def _card(self, episodes: int, frames: int, tasks: list[str]) -> str:
+        return dataset_card(self._info(episodes, frames, len(tasks)), tasks)
+
+    def _write_marker(self) -> None:
+        """``meta/vcage.json``: the format, the config, and ``meta/info.json`` without its totals (so
+        that :func:`vcage.data.verify.repair` can rebuild a damaged ``info.json``)."""
+        static = {k: v for k, v in self._info(0, 0, 0).items()
+                  if k not in ("total_episodes", "total_frames", "total_tasks", "splits")}
+        write_json(self.root / layout.VCAGE_PATH, {"format": "vcage/lerobot-v3", "config": self.config,
+                                                   "info": static})
 
     def _write_meta(self, tasks: list[str], chunk_rows: list[dict[str, Any]],
                     stats: dict[str, dict[str, np.ndarray]]) -> None:
@@ -208,7 +278,7 @@ class DatasetWriter:
         write_table(self.root / layout.TASKS_PATH, tasks_table(tasks))
         chunk = chunk_rows[-1]["episode_index"] // self.chunks_size
         write_table(self.root / layout.EPISODES_PATH.format(chunk_index=chunk, file_index=0),
-                    pa.Table.from_pylist(chunk_rows))
+                    episodes_table(chunk_rows))
         write_json(self.root / layout.STATS_PATH, st.to_json(stats))
 
     def _validate(self, frames: Mapping[str, Any], videos: Mapping[str, Any]) -> dict[str, np.ndarray]:
@@ -279,16 +349,9 @@ class DatasetWriter:
         chunk, file = divmod(index, self.chunks_size)
         tasks = self._tasks if task in self._tasks else [*self._tasks, task]
         table = self._data_table(checked, index, tasks.index(task), length)
-        row: dict[str, Any] = {
-            "episode_index": index, "tasks": [task], "length": length,
-            "data/chunk_index": chunk, "data/file_index": file,
-            "dataset_from_index": self._total_frames, "dataset_to_index": self._total_frames + length}
-        for key in self.cameras:
-            row |= {f"videos/{key}/chunk_index": chunk, f"videos/{key}/file_index": file,
-                    f"videos/{key}/from_timestamp": 0.0, f"videos/{key}/to_timestamp": length / self.fps}
-        row |= {"meta/episodes/chunk_index": chunk, "meta/episodes/file_index": 0}
         episode_stats = self._episode_stats(table, checked)
-        row |= st.to_row(episode_stats)
+        row = episode_row(index, task, length, self._total_frames, chunks_size=self.chunks_size, fps=self.fps,
+                          cameras=list(self.cameras), stats=episode_stats, extras=extras_json)
         chunk_rows = [*(self._chunk_rows if file else []), row]
         stats = st.merge(self._stats, episode_stats)
         written: list[Path] = []
@@ -301,8 +364,12 @@ class DatasetWriter:
         try:
             self._write_files(index, table, checked, extras_json if extras else None, states, written)
             meta_touched = True
+            if self._fresh and index == 0:
+                self._write_marker()
             self._write_meta(tasks, chunk_rows, stats)
-            self._write_info(index + 1, self._total_frames + length, len(tasks))
+            frames_after = self._total_frames + length
+            write_text(self.root / layout.CARD_PATH, self._card(index + 1, frames_after, tasks))
+            self._write_info(index + 1, frames_after, len(tasks))
         except BaseException:
             if self._committed(index + 1):  # interrupted after the commit point: the episode is in
                 commit()
@@ -353,9 +420,14 @@ class DatasetWriter:
         with contextlib.suppress(Exception):
             if self._total_episodes:
                 self._write_meta(self._tasks, self._chunk_rows, self._stats)
+                write_text(self.root / layout.CARD_PATH, self._card(self._total_episodes, self._total_frames,
+                                                                    self._tasks))
             else:
                 (self.root / layout.TASKS_PATH).unlink(missing_ok=True)
                 (self.root / layout.STATS_PATH).unlink(missing_ok=True)
+                (self.root / layout.CARD_PATH).unlink(missing_ok=True)
+                if self._fresh:
+                    (self.root / layout.VCAGE_PATH).unlink(missing_ok=True)
             if index % self.chunks_size == 0:
                 chunk = index // self.chunks_size
                 episodes = self.root / layout.EPISODES_PATH.format(chunk_index=chunk, file_index=0)

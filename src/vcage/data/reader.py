@@ -6,6 +6,8 @@
 from __future__ import annotations
 
 import json
+import zipfile
+import zlib
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -25,7 +27,7 @@ from vcage.data.layout import (
     VCAGE_PATH,
 )
 from vcage.data.video import decode_video
-from vcage.errors import DatasetError
+from vcage.errors import CorruptDatasetError, DatasetError
 
 DTYPES = {"float32": pa.float32(), "float64": pa.float64(), "int32": pa.int32(), "int64": pa.int64(),
           "bool": pa.bool_()}
@@ -87,17 +89,30 @@ def load_json(path: Path) -> Any:
     except FileNotFoundError:
         raise DatasetError(f"{path} is missing; the dataset is incomplete or this is not a dataset") from None
     except (OSError, ValueError) as exc:
-        raise DatasetError(f"{path} is not readable JSON: {exc}") from exc
+        raise CorruptDatasetError(f"{path} is not readable JSON: {exc}") from exc
 
 
 def read_parquet(path: Path) -> pa.Table:
     """Read a parquet file; missing or unreadable files raise DatasetError naming the file."""
     if not path.is_file():
-        raise DatasetError(f"{path} is missing; the dataset is incomplete")
+        raise CorruptDatasetError(f"{path} is missing; the dataset is incomplete")
     try:
         return pq.read_table(path)
-    except (OSError, pa.ArrowException) as exc:
-        raise DatasetError(f"{path} is not a readable parquet file: {exc}") from exc
+    except (OSError, ValueError, pa.ArrowException) as exc:
+        raise CorruptDatasetError(f"{path} is not a readable parquet file: {exc}") from exc
+
+
+# What reading a damaged npz raises: a truncated zip, a bad CRC, a broken deflate stream, a bad header.
+NPZ_ERRORS = (zipfile.BadZipFile, zlib.error, EOFError, OSError, ValueError, KeyError)
+
+
+def load_npz(path: Path) -> dict[str, np.ndarray]:
+    """Every array of an ``.npz`` file; CorruptDatasetError naming the file if it cannot be read."""
+    try:
+        with np.load(path, allow_pickle=False) as npz:
+            return {key: npz[key] for key in npz.files}
+    except NPZ_ERRORS as exc:
+        raise CorruptDatasetError(f"{path} is not a readable npz file: {exc}") from exc
 
 
 def column_to_numpy(column: pa.ChunkedArray | pa.Array) -> np.ndarray:
@@ -120,9 +135,15 @@ class DatasetReader:
         try:
             self._parse_info()
         except (KeyError, TypeError, ValueError) as exc:
-            raise DatasetError(f"{self.root / INFO_PATH} lacks or mangles a required key: {exc}") from exc
+            raise CorruptDatasetError(f"{self.root / INFO_PATH} lacks or mangles a required key: "
+                                      f"{exc}") from exc
         vcage = self.root / VCAGE_PATH
-        self.config: dict[str, Any] | None = load_json(vcage).get("config") if vcage.exists() else None
+        self.config: dict[str, Any] | None = None
+        if vcage.exists():
+            marker = load_json(vcage)
+            if not isinstance(marker, dict):
+                raise CorruptDatasetError(f"{vcage} does not hold a JSON object; the dataset is corrupt")
+            self.config = marker.get("config")
         self._uncommitted = False  # meta rows beyond the commit point (left by a crash)
         self.tasks: list[str] = self._read_tasks() if self.num_episodes else []
         self._rows: list[dict[str, Any]] = self._read_episode_rows() if self.num_episodes else []
@@ -149,13 +170,15 @@ class DatasetReader:
         path = self.root / TASKS_PATH
         table = read_parquet(path)
         if "task" not in table.column_names or "task_index" not in table.column_names:
-            raise DatasetError(f"{path} needs columns 'task' and 'task_index', has {table.column_names}")
+            raise CorruptDatasetError(f"{path} needs columns 'task' and 'task_index', has "
+                                      f"{table.column_names}")
         by_index = dict(zip(table.column("task_index").to_pylist(), table.column("task").to_pylist(),
                             strict=True))
         total = int(self.info.get("total_tasks", len(by_index)))
         self._uncommitted |= len(by_index) > total
         if sorted(by_index)[:total] != list(range(total)):
-            raise DatasetError(f"{path} does not hold task indices 0..{total - 1} that {INFO_PATH} declares")
+            raise CorruptDatasetError(f"{path} does not hold task indices 0..{total - 1} that {INFO_PATH} "
+                                      "declares")
         return [by_index[i] for i in range(total)]
 
     def _read_episode_rows(self) -> list[dict[str, Any]]:
@@ -169,13 +192,14 @@ class DatasetReader:
                     self._uncommitted = True
         if len(rows) != self.num_episodes:
             where = ", ".join(str(p.relative_to(self.root)) for p in files) or "meta/episodes/ (no files)"
-            raise DatasetError(f"episode count mismatch: {self.root / INFO_PATH} says {self.num_episodes} "
-                               f"episodes but {where} describe {len(rows)} of them; the dataset is corrupt")
+            raise CorruptDatasetError(f"episode count mismatch: {self.root / INFO_PATH} says "
+                                      f"{self.num_episodes} episodes but {where} describe {len(rows)} of "
+                                      "them; the dataset is corrupt")
         ordered = [rows[i] for i in range(self.num_episodes)]
         total = sum(int(r["length"]) for r in ordered)
         if total != self.total_frames:
-            raise DatasetError(f"{self.root / INFO_PATH} says {self.total_frames} frames but the episodes "
-                               f"add up to {total}; the dataset is corrupt")
+            raise CorruptDatasetError(f"{self.root / INFO_PATH} says {self.total_frames} frames but the "
+                                      f"episodes add up to {total}; the dataset is corrupt")
         return ordered
 
     def _check_files(self) -> None:
@@ -183,7 +207,7 @@ class DatasetReader:
             paths = [self.data_path(i)] + [self.video_path(i, key) for key in self.cameras]
             for path in paths:
                 if not path.is_file():
-                    raise DatasetError(f"{path} (episode {i}) is missing; the dataset is corrupt")
+                    raise CorruptDatasetError(f"{path} (episode {i}) is missing; the dataset is corrupt")
 
     def __len__(self) -> int:
         return self.num_episodes
@@ -214,10 +238,10 @@ class DatasetReader:
         path = self.data_path(index)
         table = read_parquet(path)
         if "episode_index" not in table.column_names:
-            raise DatasetError(f"{path} has no 'episode_index' column; the dataset is corrupt")
+            raise CorruptDatasetError(f"{path} has no 'episode_index' column; the dataset is corrupt")
         table = table.filter(pc.equal(table.column("episode_index"), index))
         if table.num_rows != row["length"]:
-            raise DatasetError(f"{path} holds {table.num_rows} frames of episode {index}, "
+            raise CorruptDatasetError(f"{path} holds {table.num_rows} frames of episode {index}, "
                                f"meta/episodes says {row['length']}; the dataset is corrupt")
         frames = {name: column_to_numpy(table.column(name)) for name in table.column_names}
         for name, feature in self.features.items():
@@ -229,17 +253,18 @@ class DatasetReader:
 
     def extras(self, index: int) -> dict[str, Any]:
         path = self.root / EXTRAS_PATH.format(episode_index=index)
-        return dict(load_json(path)) if path.exists() else {}
+        if not path.exists():
+            return {}
+        extras = load_json(path)
+        if not isinstance(extras, dict):
+            raise CorruptDatasetError(f"{path} does not hold a JSON object; the dataset is corrupt")
+        return extras
 
     def arrays(self, index: int) -> dict[str, np.ndarray]:
         path = self.root / ARRAYS_PATH.format(episode_index=index)
         if not path.exists():
             return {}
-        try:
-            with np.load(path, allow_pickle=False) as npz:
-                return {key: npz[key] for key in npz.files}
-        except (OSError, ValueError) as exc:
-            raise DatasetError(f"{path} is not a readable npz file: {exc}") from exc
+        return load_npz(path)
 
     def video(self, index: int, key: str) -> np.ndarray:
         """Decoded frames (T, H, W, 3) uint8 of one camera for one episode."""
@@ -250,6 +275,6 @@ class DatasetReader:
         start, stop = float(row[f"videos/{key}/from_timestamp"]), float(row[f"videos/{key}/to_timestamp"])
         keep = (times >= start - half) & (times < stop - half)
         if int(keep.sum()) != row["length"]:
-            raise DatasetError(f"{path} holds {int(keep.sum())} frames for episode {index}, "
+            raise CorruptDatasetError(f"{path} holds {int(keep.sum())} frames for episode {index}, "
                                f"expected {row['length']}; the dataset is corrupt")
         return frames[keep]

@@ -8,7 +8,9 @@ replay in vcage), ``rewards`` (1 on the last frame of an episode the oracle conf
 written (it would double the file); train with robomimic's ``hdf5_load_next_obs=False``.
 
 The file is written next to its destination and renamed into place, so an interrupted export
-leaves no partial file, and an existing file is only replaced when asked.
+leaves no partial file, and an existing file is only replaced when asked. A damaged dataset is
+refused (CorruptDatasetError naming the files) by the cheap checks before anything is written,
+and by the reads themselves for damage those checks cannot see.
 """
 
 from __future__ import annotations
@@ -22,7 +24,8 @@ import h5py
 import numpy as np
 
 from vcage.data.reader import DatasetReader
-from vcage.errors import DatasetError
+from vcage.data.verify import check
+from vcage.errors import CorruptDatasetError, DatasetError
 
 
 @dataclass(frozen=True)
@@ -45,11 +48,15 @@ def obs_key(feature: str) -> str:
 
 def export_robomimic(dataset: str | Path, out: str | Path, *, valid_fraction: float = 0.1, seed: int = 0,
                      overwrite: bool = False) -> ExportSummary:
-    """Write the dataset at ``dataset`` as a robomimic HDF5 file at ``out``."""
-    reader = DatasetReader(dataset)
+    """Write the dataset at ``dataset`` as a robomimic HDF5 file at ``out``.
+
+    CorruptDatasetError if the dataset's files are damaged (run ``vcage verify --repair``).
+    """
     out = Path(out)
     if not 0.0 <= valid_fraction < 1.0:
         raise DatasetError(f"valid_fraction must be in [0, 1), got {valid_fraction}")
+    check(dataset).raise_if_damaged()
+    reader = DatasetReader(dataset)
     if reader.num_episodes == 0:
         raise DatasetError(f"{reader.root} has no episodes to export")
     if out.exists() and not overwrite:
@@ -67,7 +74,11 @@ def export_robomimic(dataset: str | Path, out: str | Path, *, valid_fraction: fl
         with h5py.File(tmp, "w") as f:
             data = f.create_group("data")
             for k, name in enumerate(names):
-                frames += _write_demo(data.create_group(name), reader, k, features)
+                try:
+                    frames += _write_demo(data.create_group(name), reader, k, features)
+                except CorruptDatasetError as exc:
+                    raise CorruptDatasetError(f"episode {k} of {reader.root} is damaged: {exc}; run `vcage "
+                                              f"verify {reader.root} --repair` to drop it") from exc
             data.attrs["total"] = frames
             data.attrs["env_args"] = json.dumps({
                 "env_name": reader.tasks[0] if reader.tasks else "",

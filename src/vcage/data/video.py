@@ -3,13 +3,15 @@
 from __future__ import annotations
 
 import os
+import struct
+from dataclasses import dataclass
 from fractions import Fraction
 from pathlib import Path
 
 import av
 import numpy as np
 
-from vcage.errors import DatasetError
+from vcage.errors import CorruptDatasetError, DatasetError
 
 PIX_FMT = "yuv420p"
 
@@ -98,8 +100,85 @@ def decode_video(path: Path) -> tuple[np.ndarray, np.ndarray]:
             for frame in container.decode(stream):
                 frames.append(frame.to_ndarray(format="rgb24"))
                 times.append(float(frame.time) if frame.time is not None else float("nan"))
-    except (av.FFmpegError, IndexError, OSError) as exc:
-        raise DatasetError(f"cannot decode video {path}: {exc}") from exc
+    except (av.FFmpegError, IndexError, OSError, ValueError) as exc:
+        raise CorruptDatasetError(f"cannot decode video {path}: {exc}") from exc
     if not frames:
-        raise DatasetError(f"video {path} holds no frames")
+        raise CorruptDatasetError(f"video {path} holds no frames")
     return np.stack(frames), np.asarray(times, dtype=np.float64)
+
+
+@dataclass(frozen=True)
+class Probe:
+    """What a video's container says without decoding: frame count and frame size."""
+
+    frames: int
+    height: int
+    width: int
+
+
+def check_boxes(path: Path) -> None:
+    """Raise CorruptDatasetError unless the MP4's top-level boxes tile the file exactly.
+
+    A truncated MP4 ends inside a box (its ``moov`` or ``mdat``); reading the box headers costs a
+    few small reads, however long the video.
+    """
+    size = path.stat().st_size
+    offset = 0
+    with path.open("rb") as f:
+        while offset < size:
+            f.seek(offset)
+            head = f.read(16)
+            if len(head) < 8:
+                raise CorruptDatasetError(f"{path} ends inside a box header at byte {offset}; the file is "
+                                          "truncated")
+            box, kind = struct.unpack(">I", head[:4])[0], head[4:8]
+            if box == 1:
+                if len(head) < 16:
+                    raise CorruptDatasetError(f"{path} ends inside a box header at byte {offset}; the file "
+                                              "is truncated")
+                box = struct.unpack(">Q", head[8:16])[0]
+            elif box == 0:  # the last box runs to the end of the file
+                box = size - offset
+            if box < 8:
+                raise CorruptDatasetError(f"{path} has a malformed box {kind!r} at byte {offset}")
+            if offset + box > size:
+                raise CorruptDatasetError(
+                    f"{path} is truncated: box {kind.decode('latin-1')!r} at byte {offset} needs "
+                    f"{box} bytes, the file has {size - offset} left")
+            offset += box
+    if size == 0:
+        raise CorruptDatasetError(f"{path} is empty")
+
+
+def probe_video(path: Path) -> Probe:
+    """Frame count and size from the container (no decoding); CorruptDatasetError if it cannot be read.
+
+    The count is the stream's ``nb_frames`` from the MP4 index; where the container does not record
+    it, the packets are counted (read, not decoded).
+    """
+    check_boxes(path)
+    try:
+        with av.open(str(path)) as container:
+            stream = container.streams.video[0]
+            frames = int(stream.frames)
+            if frames <= 0:
+                frames = sum(1 for packet in container.demux(stream) if packet.size)
+            return Probe(frames, int(stream.codec_context.height), int(stream.codec_context.width))
+    except (av.FFmpegError, IndexError, OSError, ValueError) as exc:
+        raise CorruptDatasetError(f"cannot open video {path}: {exc}") from exc
+
+
+def decode_times(path: Path) -> np.ndarray:
+    """Decode every frame of an MP4 (without converting it to RGB) and return the timestamps (T,).
+
+    Costs a full decode; CorruptDatasetError if the stream cannot be decoded.
+    """
+    times: list[float] = []
+    try:
+        with av.open(str(path)) as container:
+            stream = container.streams.video[0]
+            for frame in container.decode(stream):
+                times.append(float(frame.time) if frame.time is not None else float("nan"))
+    except (av.FFmpegError, IndexError, OSError, ValueError) as exc:
+        raise CorruptDatasetError(f"cannot decode video {path}: {exc}") from exc
+    return np.asarray(times, dtype=np.float64)

@@ -1,0 +1,41 @@
+"""``vcage verify``: check every file of a dataset against its metadata; ``--repair`` drops a damaged tail."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import typer
+from rich.text import Text
+
+from vcage.cli._app import app, console
+from vcage.cli.errors import cli_errors
+from vcage.cli.problems import print_problems
+from vcage.errors import CorruptDatasetError
+
+
+@app.command("verify")
+@cli_errors
+def verify_cmd(path: Path = typer.Argument(..., help="a dataset directory"),
+               repair: bool = typer.Option(False, "--repair", help="drop the episodes from the first damaged "
+                                           "one to the end and rewrite the metadata (says what it drops)")
+               ) -> None:
+    """Check every episode's files (decoding the videos) and the metadata; fails if anything is damaged."""
+    from vcage.data.verify import repair as repair_dataset
+    from vcage.data.verify import verify
+
+    if repair:
+        result = repair_dataset(path)
+        print_problems(result.before)
+        console.print(Text(result.summary()))
+        if not result.after.ok:
+            print_problems(result.after)
+            raise CorruptDatasetError(f"{path} is still damaged after the repair: {result.after.brief()}")
+        return
+    report = verify(path)
+    print_problems(report)
+    if report.ok:
+        console.print(Text(report.summary()))
+        return
+    console.print(Text(report.summary().splitlines()[-1]))
+    raise CorruptDatasetError(f"{path} is damaged: {report.brief()}; `vcage verify {path} --repair` drops "
+                              "the damaged episodes")
