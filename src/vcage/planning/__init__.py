@@ -14,7 +14,7 @@ from vcage.backends import BackendConfig, connect
 from vcage.planning.config import PlannerConfig
 from vcage.planning.llm import LLMPlanner
 from vcage.planning.offline import OfflinePlanner
-from vcage.planning.schema import Plan
+from vcage.planning.schema import GoalMatch, Plan
 from vcage.registry import Registry
 
 LLM_ENV_PREFIX = "VCAGE_LLM"  # where the endpoint is read from when the config names none
@@ -28,8 +28,9 @@ class Planner(Protocol):
 
 PlannerFactory = Callable[[PlannerConfig], Planner]
 PLANNERS: Registry[PlannerFactory] = Registry("planner")
-PLANNERS.add("offline", lambda cfg: OfflinePlanner())
-PLANNERS.add("llm", lambda cfg: LLMPlanner(connect(cfg.backend or BackendConfig.from_env(LLM_ENV_PREFIX))))
+PLANNERS.add("offline", lambda cfg: OfflinePlanner(max_subtasks=cfg.max_subtasks))
+PLANNERS.add("llm", lambda cfg: LLMPlanner(connect(cfg.backend or BackendConfig.from_env(LLM_ENV_PREFIX)),
+                                           max_subtasks=cfg.max_subtasks))
 
 
 def make_planner(config: PlannerConfig | str = "offline") -> Planner:
@@ -38,4 +39,5 @@ def make_planner(config: PlannerConfig | str = "offline") -> Planner:
     return PLANNERS.get(cfg.name)(cfg)
 
 
-__all__ = ["PLANNERS", "LLMPlanner", "OfflinePlanner", "Plan", "Planner", "PlannerConfig", "make_planner"]
+__all__ = ["PLANNERS", "GoalMatch", "LLMPlanner", "OfflinePlanner", "Plan", "Planner", "PlannerConfig",
+           "make_planner"]

@@ -10,7 +10,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
-from vcage.planning.schema import Plan, PlanObject, PlanRelation, Predicate, Subtask
+from vcage.planning.schema import GoalMatch, Plan, PlanObject, PlanRelation, Predicate, Subtask
 
 
 @dataclass(frozen=True)
@@ -21,9 +21,13 @@ class Goal:
     subtasks: tuple[Subtask, ...]
     relations: tuple[PlanRelation, ...] = ()
 
-    def plan(self, instruction: str) -> Plan:
-        return Plan(instruction=instruction, goal=self.name, objects=self.objects,
-                    relations=self.relations, subtasks=self.subtasks)
+    def plan(self, instruction: str, match: GoalMatch | None = None,
+             objects: tuple[PlanObject, ...] | None = None) -> Plan:
+        """The goal's plan labelled ``instruction`` (``objects``: the goal's objects with colours the
+        instruction chose, same names and order)."""
+        return Plan(instruction=instruction, goal=self.name,
+                    objects=self.objects if objects is None else objects,
+                    relations=self.relations, subtasks=self.subtasks, match=match)
 
 
 def _obj(name: str, type_: str, color: str | None = None) -> PlanObject:

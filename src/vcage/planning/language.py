@@ -2,7 +2,8 @@
 
 Words are lower-cased, stripped of punctuation, reduced by a light suffix stemmer and mapped to a
 canonical synonym, so that "tidy up my desk", "clean the desk" and "organising the workspace"
-share tokens. Similarity is an IDF-weighted overlap of token sets.
+share tokens. Similarity is an IDF-weighted overlap of token sets. ``bounded`` quotes user text in
+error messages without repeating more than ``QUOTE_LIMIT`` characters of it.
 """
 
 from __future__ import annotations
@@ -10,11 +11,22 @@ from __future__ import annotations
 import math
 import re
 from collections.abc import Iterable
+from dataclasses import dataclass
+
+QUOTE_LIMIT = 200  # characters of user text an error message may repeat
+
+
+def bounded(text: str, limit: int = QUOTE_LIMIT) -> str:
+    """``text`` quoted for a message: whole if short, else its start, an ellipsis and its length."""
+    if len(text) <= limit:
+        return repr(text)
+    return f"{text[:limit] + '...'!r} ({len(text)} characters, the first {limit} shown)"
 
 _STOP_WORDS = """
 a an the my our your his her their its this that these those to for of and or please can could
 would you will i we me us it be is are get go do some all just now then up down with at by let
-lets want need like"""
+lets want need like
+d m s ll re ve t"""  # the pieces contractions leave ("i'd", "i'm", "it's", "we'll", "don't")
 STOP = frozenset(_STOP_WORDS.split())
 
 # canonical word <- variants (after stemming)
@@ -52,7 +64,7 @@ _CANON = {form: k for k, vs in SYNONYMS.items() for v in vs for form in (v, stem
 
 def tokens(text: str) -> list[str]:
     """Canonical content tokens of ``text``."""
-    words = re.findall(r"[a-z]+", text.lower().replace("set up", "setup"))
+    words = re.findall(r"[a-z0-9]+", text.lower().replace("set up", "setup"))
     out = []
     for w in words:
         if w in STOP:
@@ -60,6 +72,15 @@ def tokens(text: str) -> list[str]:
         s = stem(w)
         out.append(_CANON.get(s, _CANON.get(w, s)))
     return out
+
+
+@dataclass(frozen=True)
+class Scored:
+    """A label's score for a text, and the text's tokens its best phrasing shares (the evidence)."""
+
+    label: str
+    score: float
+    evidence: frozenset[str]
 
 
 class Matcher:
@@ -78,14 +99,28 @@ class Matcher:
     def _w(self, tok: str) -> float:
         return self.idf.get(tok, self.default_idf)
 
-    def score(self, text: str) -> list[tuple[float, str]]:
-        """(score, label) for every label, best first; a label's score is its best phrasing's."""
+    @property
+    def vocabulary(self) -> frozenset[str]:
+        """Every token of every phrasing."""
+        return frozenset(t for _, toks in self.entries for t in toks)
+
+    def vocabulary_of(self, label: str) -> frozenset[str]:
+        return frozenset(t for lab, toks in self.entries if lab == label for t in toks)
+
+    def rank(self, text: str) -> list[Scored]:
+        """Every label scored, best first (ties by label); a label's score is its best phrasing's."""
         query = set(tokens(text))
-        best: dict[str, float] = {}
+        best: dict[str, Scored] = {}
         for label, toks in self.entries:
             union = query | toks
             if not union:
                 continue
-            s = sum(self._w(t) for t in query & toks) / sum(self._w(t) for t in union)
-            best[label] = max(best.get(label, 0.0), s)
-        return sorted(((s, label) for label, s in best.items()), reverse=True)
+            shared = query & toks
+            s = sum(self._w(t) for t in shared) / sum(self._w(t) for t in union)
+            if label not in best or s > best[label].score:
+                best[label] = Scored(label, s, frozenset(shared))
+        return sorted(best.values(), key=lambda x: (-x.score, x.label))
+
+    def score(self, text: str) -> list[tuple[float, str]]:
+        """(score, label) for every label, best first; a label's score is its best phrasing's."""
+        return sorted(((x.score, x.label) for x in self.rank(text)), reverse=True)

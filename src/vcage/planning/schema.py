@@ -3,14 +3,24 @@
 A plan names the objects of the scene (catalog types, optionally standing on another object),
 relations for their initial layout, and an ordered list of subtasks. Each subtask is one skill
 call with arguments, a short description (what a critic is asked about) and the ground-truth
-predicates that define its success (what the oracle checks).
+predicates that define its success (what the oracle checks). A plan matched to a library goal says
+how confidently (``match``); that field is optional and left out of dumps when absent, so plans
+written before it existed, and plans without a goal, read and dump as before.
 """
 
 from __future__ import annotations
 
 from typing import Any, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
+from pydantic import (
+    BaseModel,
+    ConfigDict,
+    Field,
+    SerializerFunctionWrapHandler,
+    field_validator,
+    model_serializer,
+    model_validator,
+)
 
 from vcage.assets.catalog import CATALOG
 from vcage.vocabulary import PLAN_SKILLS, PREDICATES
@@ -82,12 +92,33 @@ class Subtask(_Strict):
         return named + [a for p in self.predicates for a in p.args]
 
 
+class GoalMatch(_Strict):
+    """How an instruction matched its library goal: the confidence (0..1), the threshold it had to
+    reach, and the runners-up with theirs."""
+
+    score: float = Field(ge=0.0, le=1.0)
+    threshold: float = Field(ge=0.0, le=1.0)
+    alternatives: tuple[tuple[str, float], ...] = ()
+
+    def __str__(self) -> str:
+        alts = ", ".join(f"{g} {s:.2f}" for g, s in self.alternatives)
+        return f"match {self.score:.2f} >= {self.threshold:.2f}" + (f"; next: {alts}" if alts else "")
+
+
 class Plan(_Strict):
     instruction: str = Field(min_length=1)
     goal: str | None = None  # the library goal it was matched to, if any
     objects: tuple[PlanObject, ...] = Field(min_length=1)
     relations: tuple[PlanRelation, ...] = ()
     subtasks: tuple[Subtask, ...] = Field(min_length=1)
+    match: GoalMatch | None = None  # how confidently ``goal`` was matched (None: not matched)
+
+    @model_serializer(mode="wrap")
+    def _without_empty_match(self, handler: SerializerFunctionWrapHandler) -> Any:
+        data = handler(self)
+        if isinstance(data, dict) and data.get("match", 0) is None:
+            del data["match"]  # plans without a goal match dump exactly as before the field existed
+        return data
 
     @model_validator(mode="after")
     def _references(self) -> Plan:
@@ -113,7 +144,8 @@ class Plan(_Strict):
         return next(o for o in self.objects if o.name == name)
 
     def summary(self) -> str:
-        lines = [f"instruction: {self.instruction}" + (f"  (goal: {self.goal})" if self.goal else "")]
+        goal = f"  (goal: {self.goal}{', ' + str(self.match) if self.match else ''})" if self.goal else ""
+        lines = [f"instruction: {self.instruction}{goal}"]
         lines.append("objects: " + ", ".join(
             f"{o.name} ({(o.color + ' ') if o.color else ''}{o.type}{', on ' + o.on if o.on else ''})"
             for o in self.objects))
@@ -125,5 +157,9 @@ class Plan(_Strict):
 
 
 def plan_json_schema() -> dict[str, Any]:
-    """The JSON schema an LLM planner is asked to follow."""
-    return Plan.model_json_schema()
+    """The JSON schema an LLM planner is asked to follow (without ``match``, which the planner that
+    matched a goal fills in, never a model)."""
+    schema = Plan.model_json_schema()
+    schema["properties"].pop("match", None)
+    schema.get("$defs", {}).pop("GoalMatch", None)
+    return schema
