@@ -52,7 +52,7 @@ def test_the_vlm_endpoint_is_stored_with_the_data_and_the_key_never(
     secret = "sk-test-never-on-disk-0123456789"
     monkeypatch.setenv("VCAGE_VLM_API_KEY", secret)
     out = tmp_path / "ds"
-    with FakeOpenAI() as server:
+    with FakeOpenAI("fake-vlm") as server:
         server.script(*([YES] * 4))
         made = RUN.invoke(app, ["generate", "press the bell", "--episodes", "1", "--out", str(out),
                                 "--critic", "vlm", "--critic-url", server.base_url,
@@ -61,7 +61,10 @@ def test_the_vlm_endpoint_is_stored_with_the_data_and_the_key_never(
     critic = json.loads((out / VCAGE_PATH).read_text())["config"]["generate"]["critic"]
     assert critic["name"] == "vlm" and critic["backend"]["model"] == "fake-vlm"
     assert critic["backend"]["base_url"] == server.base_url
-    assert critic["backend"]["api_key_env"] == "VCAGE_VLM_API_KEY" and "api_key" not in critic["backend"]
+    assert "api_key" not in critic["backend"]
+    assert "timeout" not in critic["backend"]  # how it is reached is not compared when appending
+    full = DatasetReader(out).extras(0)["config"]["critic"]["backend"]  # every episode: the whole tree
+    assert full["api_key_env"] == "VCAGE_VLM_API_KEY" and full["timeout"] == 30.0 and "api_key" not in full
     for path in out.rglob("*"):
         if path.is_file():
             assert secret.encode() not in path.read_bytes(), path

@@ -11,8 +11,9 @@ import pytest
 
 from vcage.config import RenderConfig
 from vcage.data import DatasetReader
-from vcage.data.layout import ATTEMPTS_LOG, FUNNEL_PATH, VCAGE_PATH
+from vcage.data.layout import ATTEMPTS_LOG, RUNS_LOG, VCAGE_PATH
 from vcage.errors import ConfigError, DatasetError, PlanningError, RegistryError, SceneError
+from vcage.pipeline.attempt_log import read
 from vcage.pipeline.audit import audit
 from vcage.pipeline.config import ExecutorConfig, GenerateConfig
 from vcage.pipeline.generate import generate
@@ -40,7 +41,7 @@ def test_generate_writes_a_verified_dataset(tmp_path: Path) -> None:
     assert bounds[0][0] == 0 and bounds[0][1] <= bounds[1][0] and bounds[1][1] <= ep.length
     assert ep.arrays["states"].shape[0] == ep.length
     assert reader.video(0, "observation.images.front").shape == (ep.length, 64, 64, 3)
-    stats = json.loads((out / FUNNEL_PATH).read_text())
+    stats = read(out / RUNS_LOG)[-1]
     assert stats["accepted"] == 1 and stats["stages"]["accepted"] == 1
     seconds = stats["seconds"]
     assert seconds["physics"] > 0 and seconds["render"] > 0
@@ -87,7 +88,7 @@ def test_workers_make_the_same_dataset(tmp_path: Path) -> None:
                                       b.video(k, "observation.images.front"))
     logs = [(tmp_path / d / ATTEMPTS_LOG).read_text().splitlines() for d in ("one", "two")]
     assert [json.loads(r)["seed"] for r in logs[0]] == [json.loads(r)["seed"] for r in logs[1]]
-    stats = json.loads((tmp_path / "two" / FUNNEL_PATH).read_text())
+    stats = read(tmp_path / "two" / RUNS_LOG)[-1]
     assert stats["core_seconds"] == pytest.approx(2 * stats["wall_seconds"], rel=0.01)
     # the workers are stored with each episode, yet do not change what must match to append
     assert b.extras(0)["config"]["executor"]["workers"] == 2

@@ -11,7 +11,7 @@ import typer
 from rich.table import Table
 
 from vcage.cli._app import app, console
-from vcage.cli.errors import cli_errors
+from vcage.cli.errors import EXIT_PARTIAL, cli_errors, fail
 from vcage.errors import ConfigError
 
 if TYPE_CHECKING:
@@ -22,7 +22,10 @@ if TYPE_CHECKING:
 @cli_errors
 def generate_cmd(
         instruction: str = typer.Argument(..., help="e.g. 'get ready for work'"),
-        episodes: int = typer.Option(3, min=1, help="accepted episodes to produce"),
+        episodes: int = typer.Option(3, min=0, help="accepted episodes to add (with --total: the "
+                                     "episodes the dataset must hold)"),
+        total: bool = typer.Option(False, help="make the dataset hold --episodes episodes in all: "
+                                   "completes an interrupted or partial run"),
         out: Path = typer.Option(Path("out/dataset"), help="dataset directory (LeRobot v3 layout)"),
         config: Path = typer.Option(None, help="a JSON configuration tree to start from (e.g. the "
                                     "\"generate\" part of a dataset's meta/vcage.json); options "
@@ -52,10 +55,12 @@ def generate_cmd(
         executor: str = typer.Option(None, help="local (this machine: processes) or ray"),
         address: str = typer.Option(None, help="with --executor ray: a running cluster's address "
                                     "(e.g. auto); default: start Ray locally")) -> None:
-    """Generate a verified dataset for INSTRUCTION; prints the funnel and writes stats.json."""
+    """Generate a verified dataset for INSTRUCTION; prints the funnel (also appended to
+    meta/vcage_runs.jsonl). Exit code 3 when fewer episodes were accepted than asked."""
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
     from vcage.pipeline.generate import generate
+    from vcage.planning import make_planner
 
     cfg = build_config(config, mode, {
         ("planner", "name"): planner, ("critic", "name"): critic, ("critic", "votes"): votes,
@@ -66,6 +71,8 @@ def generate_cmd(
         ("executor", "name"): executor, ("executor", "workers"): workers, ("executor", "address"): address,
     }, {"planner": ("VCAGE_LLM", planner_provider, planner_url, planner_model),
         "critic": ("VCAGE_VLM", critic_provider, critic_url, critic_model)})
+    cfg = cfg.resolved()
+    plan = make_planner(cfg.planner).plan(instruction)  # before any progress is shown
     with Progress(TextColumn("{task.description}"), BarColumn(),
                   TextColumn("{task.completed}/{task.total}"), TimeElapsedColumn(),
                   console=console) as bar:
@@ -78,8 +85,13 @@ def generate_cmd(
             bar.update(job, completed=f.accepted + f.given_up,
                        description=f"episodes (attempts {f.attempts}, accepted {f.accepted})")
 
-        funnel = generate(instruction, episodes, out, cfg, progress=update)
+        funnel = generate(instruction, episodes, out, cfg, progress=update, plan=plan, total=total)
     _print_funnel(funnel.to_dict(), out)
+    if funnel.accepted < funnel.episodes_requested:
+        fail(f"only {funnel.accepted} of the {funnel.episodes_requested} episodes asked for were "
+             f"accepted ({funnel.given_up} given up after {cfg.max_attempts} attempts each); the "
+             f"dataset holds {funnel.dataset_episodes}: rerun with --total to complete it, or raise "
+             "--max-attempts", EXIT_PARTIAL)
 
 
 def build_config(path: Path | None, mode: str, options: dict[tuple[str, ...], Any],
@@ -140,4 +152,5 @@ def _print_funnel(stats: dict, out: Path) -> None:
         f"{stats['label_noise']:.1%}; {stats['wall_seconds']:.1f} s wall, "
         f"{stats['episodes_per_hour']:.0f} episodes/hour on {stats['workers']} worker(s) "
         f"({stats['episodes_per_core_hour']:.0f} per core-hour){timing}")
-    console.print(f"dataset and stats.json in {out}/")
+    console.print(f"the dataset in {out}/ holds {stats['dataset_episodes']} episodes; this run's funnel "
+                  "is appended to meta/vcage_runs.jsonl")

@@ -24,6 +24,8 @@ from vcage.planning import LLM_ENV_PREFIX, PlannerConfig
 from vcage.scene.instantiate import SceneConfig
 
 SEED_LIMIT = 2**32  # seeds are unsigned 32-bit, as numpy's SeedSequence entropy
+# how a backend is reached, not what it answers: not compared when appending to a dataset
+TRANSPORT = ("api_key_env", "timeout", "max_retries", "backoff", "max_backoff", "breaker_failures")
 
 
 @dataclass(frozen=True)
@@ -104,9 +106,14 @@ class GenerateConfig:
                 "randomization": self.randomization.to_dict(), "executor": self.executor.to_dict()}
 
     def data_dict(self) -> dict[str, Any]:
-        """What must match to append to a dataset: everything but where episodes ran."""
+        """What must match to append to a dataset: everything but where episodes ran and how
+        model endpoints are reached (timeouts, retries, the key's variable)."""
         data = self.to_dict()
         del data["executor"]
+        for part in ("planner", "critic"):
+            backend = (data[part] or {}).get("backend") or {}
+            for key in TRANSPORT:
+                backend.pop(key, None)
         return data
 
     @classmethod

@@ -2,13 +2,17 @@
 
 Each episode gets up to ``max_attempts`` attempts with derived seeds (:mod:`.sampling`); an
 accepted one is written to the dataset atomically, in episode order. Every attempt, accepted or
-not, is logged with its oracle audit in ``meta/vcage_attempts.jsonl``; the funnel goes to
-``stats.json`` (paths in :mod:`vcage.data.layout`).
+not, is logged with its oracle audit (:mod:`.attempt_log`); each run's funnel is appended to
+``meta/vcage_runs.jsonl`` (paths in :mod:`vcage.data.layout`). Nothing is written before the first
+episode of a new dataset commits.
+
+A rerun continues where the dataset's attempts stopped (new sample indices, never a repeat of an
+episode it holds), after reconciling the attempt log with what a crash may have left; with
+``total=True`` it makes the dataset hold ``episodes`` episodes, completing an interrupted run.
 """
 
 from __future__ import annotations
 
-import json
 import re
 import time
 from collections import Counter
@@ -17,8 +21,10 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from vcage.data import DatasetWriter
-from vcage.data.layout import ATTEMPTS_LOG, FUNNEL_PATH
+from vcage.data import DatasetReader, DatasetWriter
+from vcage.data.layout import ATTEMPTS_LOG, RUNS_LOG
+from vcage.errors import ConfigError
+from vcage.pipeline import attempt_log
 from vcage.pipeline.config import GenerateConfig
 from vcage.pipeline.episode import Timing
 from vcage.pipeline.executors import make_executor
@@ -33,6 +39,7 @@ class Funnel:
     """How a run went: attempts by outcome stage and reason, accepted episodes, time."""
 
     episodes_requested: int = 0
+    dataset_episodes: int = 0  # episodes the dataset holds after the run
     attempts: int = 0
     stages: Counter = field(default_factory=Counter)
     reasons: Counter = field(default_factory=Counter)
@@ -52,7 +59,8 @@ class Funnel:
         core_seconds = self.wall * self.workers
         busy = self.timing.physics + self.timing.render
         return {
-            "episodes_requested": self.episodes_requested, "attempts": self.attempts,
+            "episodes_requested": self.episodes_requested, "dataset_episodes": self.dataset_episodes,
+            "attempts": self.attempts,
             "accepted": self.accepted, "given_up": self.given_up, "stages": dict(self.stages),
             "rejections_by_reason": {f"{s}: {r}": n for (s, r), n in self.reasons.most_common()},
             "accepted_oracle_failed": self.accepted_oracle_failed, "label_noise": self.label_noise,
@@ -71,50 +79,77 @@ Progress = Callable[[Funnel], None]
 
 
 def generate(instruction: str, episodes: int, out: Path | str, cfg: GenerateConfig,
-             progress: Progress | None = None, plan: Plan | None = None) -> Funnel:
-    """Generate ``episodes`` accepted episodes into the dataset at ``out``; returns the funnel.
+             progress: Progress | None = None, plan: Plan | None = None, total: bool = False) -> Funnel:
+    """Generate ``episodes`` more accepted episodes into the dataset at ``out`` (``total``: until it
+    holds ``episodes``); returns the run's funnel.
 
     ``cfg.executor`` runs up to ``cfg.executor.workers`` episodes at once (see
     :mod:`vcage.pipeline.executors`). Each episode's attempts depend only on its seeds, so the
     dataset is the same for any executor and number of workers. The resolved configuration
     (model endpoints included, keys never) is stored with the dataset and every episode.
     """
+    if isinstance(episodes, bool) or not isinstance(episodes, int) or episodes < (0 if total else 1):
+        raise ConfigError(f"episodes must be an integer >= {0 if total else 1}, got {episodes!r}")
     out = Path(out)
     cfg = cfg.resolved()
     pool = make_executor(cfg.executor)  # checks the arguments before any work
     t0 = time.perf_counter()
     plan = plan or make_planner(cfg.planner).plan(instruction)
     critic = build_critic(cfg)  # a misconfigured critic (e.g. no API key) fails here, before any work
+    if critic is not None:
+        critic.preflight()  # an unreachable endpoint or unserved model, before any simulation
     width, height = cfg.render.size
-    funnel = Funnel(episodes_requested=episodes, workers=cfg.executor.workers)
+    funnel = Funnel(workers=cfg.executor.workers)
     with DatasetWriter(out, fps=int(cfg.sim.control_hz), features=FEATURES,
                        cameras={camera_key(c): (height, width) for c in cfg.render.cameras},
                        robot_type="franka_panda",
                        config={"generate": cfg.data_dict(), "plan": plan.model_dump(mode="json")}) as writer:
-        first = writer.num_episodes
-        for run in pool.runs(plan, cfg, range(first, first + episodes), critic):
-            _record(out, writer, plan, run, funnel)
+        log = _Log(out, writer)
+        funnel.episodes_requested = max(0, episodes - writer.num_episodes) if total else episodes
+        first = log.next_sample
+        for run in pool.runs(plan, cfg, range(first, first + funnel.episodes_requested), critic):
+            _record(writer, log, plan, run, funnel)
             funnel.wall = time.perf_counter() - t0
             if progress is not None:
                 progress(funnel)
-    funnel.wall = time.perf_counter() - t0
-    (out / FUNNEL_PATH).write_text(json.dumps(funnel.to_dict(), indent=2))
+        funnel.dataset_episodes = writer.num_episodes
+        funnel.wall = time.perf_counter() - t0
+        if writer.num_episodes:
+            attempt_log.append(out / RUNS_LOG, [{"instruction": plan.instruction, **funnel.to_dict()}])
     return funnel
 
 
-def _record(out: Path, writer: DatasetWriter, plan: Plan, run: EpisodeRun, funnel: Funnel) -> None:
-    """Log the run's attempts, count them in the funnel, and write its episode if it has one."""
-    with (out / ATTEMPTS_LOG).open("a") as f:
-        for record in run.records:
-            f.write(json.dumps(record) + "\n")
+class _Log:
+    """The dataset's attempt log, reconciled when opened; lines wait in memory until the dataset
+    exists (its first episode committed), so a run that commits nothing writes nothing."""
+
+    def __init__(self, out: Path, writer: DatasetWriter) -> None:
+        self.path, self.writer = out / ATTEMPTS_LOG, writer
+        committed = []
+        if writer.num_episodes:
+            reader = DatasetReader(out)
+            committed = [reader.extras(i) for i in range(reader.num_episodes)]
+        self.next_sample = attempt_log.reconcile(self.path, committed).next_sample
+        self.pending: list[dict[str, Any]] = []
+
+    def add(self, records: list[dict[str, Any]]) -> None:
+        self.pending += records
+        if self.writer.num_episodes:
+            attempt_log.append(self.path, self.pending)
+            self.pending = []
+
+
+def _record(writer: DatasetWriter, log: _Log, plan: Plan, run: EpisodeRun, funnel: Funnel) -> None:
+    """Count the run's attempts in the funnel, commit its episode if it has one, then log them."""
     for record, timing in zip(run.records, run.timings, strict=True):
         _count(funnel, record, timing)
     funnel.timing.render += run.video_seconds
     if run.episode is None:
         funnel.given_up += 1
-        return
-    ep = run.episode
-    writer.add_episode(ep.frames, ep.videos, task=plan.instruction, extras=ep.extras, arrays=ep.arrays)
+    else:
+        ep = run.episode
+        writer.add_episode(ep.frames, ep.videos, task=plan.instruction, extras=ep.extras, arrays=ep.arrays)
+    log.add(run.records)
 
 
 def _count(funnel: Funnel, record: dict[str, Any], timing: Timing) -> None:

@@ -64,7 +64,7 @@ def sample_episode(plan: Plan, index: int, cfg: GenerateConfig, critic: Critic |
         run.timings.append(result.timing)
         if result.accepted:
             t0 = time.perf_counter()
-            run.episode = episode_data(plan, cfg, result, j)
+            run.episode = episode_data(plan, cfg, result, run.records)
             run.video_seconds = time.perf_counter() - t0
             break
     return run
@@ -91,8 +91,11 @@ def log_record(episode: int, index: int, result: Attempt) -> dict[str, Any]:
             "verdicts": [o.verdict for o in result.rollout.outcomes] if result.rollout else []}
 
 
-def episode_data(plan: Plan, cfg: GenerateConfig, result: Attempt, index: int) -> EpisodeData:
-    """What the writer needs for accepted attempt ``index``: features, videos, extras, states."""
+def episode_data(plan: Plan, cfg: GenerateConfig, result: Attempt,
+                 attempts: list[dict[str, Any]]) -> EpisodeData:
+    """What the writer needs for the accepted attempt, the last of ``attempts`` (the log records of
+    this episode's attempts): features, videos, extras, states. The extras carry the records, so
+    the attempt log can be restored from the dataset (:mod:`.attempt_log`)."""
     assert result.recording is not None and result.world is not None and result.rollout is not None
     rec = result.recording.arrays()
     frames = {
@@ -102,12 +105,14 @@ def episode_data(plan: Plan, cfg: GenerateConfig, result: Attempt, index: int) -
     }
     states = np.asarray(result.recording.states)
     extras = {
-        "seed": result.seed, "attempt": index, "instruction": plan.instruction,
+        "seed": result.seed, "attempt": attempts[-1]["attempt"], "sample": attempts[-1]["episode"],
+        "instruction": plan.instruction,
         "plan": plan.model_dump(mode="json"),
         "config": cfg.to_dict(), "scene": result.scene.to_dict() if result.scene else None,
         "subtasks": [{"index": o.index, "description": o.description, "frames": [o.start, o.end],
                       "verdict": o.verdict} for o in result.rollout.outcomes],
         "oracle_audit": _audit(result), "oracle_success": result.oracle_success,
+        "attempts": list(attempts),
     }
     arrays = {"states": states, "initial_state": np.asarray(result.initial_state)}
     return EpisodeData(frames, _render_videos(result, states, cfg), extras, arrays)

@@ -1,0 +1,75 @@
+"""Exit codes say what happened: 0 only when the dataset holds what was asked."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from typer.testing import CliRunner
+
+from vcage.cli import app
+from vcage.critics import CRITICS, Critic, Observation, Verdict
+
+RUN = CliRunner()
+SMALL = ["--clutter", "0", "--size", "64", "--cameras", "front"]
+
+
+class Never(Critic):
+    needs_views = False
+
+    def judge(self, obs: Observation) -> Verdict:
+        return Verdict(False, "rejects everything")
+
+
+if "reject_all" not in CRITICS:
+    CRITICS.add("reject_all", lambda config: Never())
+
+
+def test_nothing_accepted_exits_3_and_writes_nothing(tmp_path: Path) -> None:
+    out = tmp_path / "ds"
+    result = RUN.invoke(app, ["generate", "press the bell", "--episodes", "1", "--out", str(out),
+                              "--critic", "reject_all", "--max-attempts", "2", *SMALL])
+    assert result.exit_code == 3, result.output
+    assert "only 0 of the 1 episodes" in " ".join(result.output.split())
+    assert not out.exists()
+
+
+def test_a_complete_run_exits_0_and_total_completes(tmp_path: Path) -> None:
+    out = tmp_path / "ds"
+    args = ["generate", "press the bell", "--out", str(out), "--critic", "oracle", *SMALL]
+    assert RUN.invoke(app, [*args, "--episodes", "1"]).exit_code == 0
+    done = RUN.invoke(app, [*args, "--episodes", "2", "--total"])
+    assert done.exit_code == 0, done.output
+    assert "holds 2 episodes" in " ".join(done.output.split())
+
+
+def test_bad_input_exits_2(tmp_path: Path) -> None:
+    result = RUN.invoke(app, ["generate", "fly to the moon", "--out", str(tmp_path / "ds")])
+    assert result.exit_code == 2 and result.output.startswith("error:")
+
+
+def test_an_unreachable_critic_endpoint_exits_4_before_any_simulation(tmp_path: Path) -> None:
+    import socket
+
+    with socket.socket() as s:  # a port nothing listens on
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    out = tmp_path / "ds"
+    result = RUN.invoke(app, ["generate", "press the bell", "--episodes", "1", "--out", str(out),
+                              "--critic", "vlm", "--critic-url", f"http://127.0.0.1:{port}/v1",
+                              "--critic-model", "m", *SMALL])
+    assert result.exit_code == 4, result.output
+    assert f"127.0.0.1:{port}" in " ".join(result.output.split())
+    assert not out.exists() or not any(out.iterdir())
+
+
+def test_a_corrupt_dataset_exits_5_and_is_never_appended_to(tmp_path: Path) -> None:
+    out = tmp_path / "ds"
+    args = ["generate", "press the bell", "--out", str(out), "--critic", "oracle", *SMALL]
+    assert RUN.invoke(app, [*args, "--episodes", "1"]).exit_code == 0
+    video = next((out / "videos").rglob("*.mp4"))
+    video.write_bytes(video.read_bytes()[: video.stat().st_size // 2])
+    verbs = (["inspect", str(out)], ["audit", str(out)], ["verify", str(out)], [*args, "--episodes", "1"])
+    for verb in verbs:
+        result = RUN.invoke(app, verb)
+        assert result.exit_code == 5, (verb[0], result.output)
+        assert "file-000.mp4" in " ".join(result.output.split()), verb[0]
