@@ -148,3 +148,19 @@ def test_llm_planner_needs_a_model_name(monkeypatch: pytest.MonkeyPatch) -> None
     with pytest.raises(ConfigError, match="VCAGE_LLM_MODEL"):
         make_planner("llm")
     assert PLANNERS.names() == ["llm", "offline"]
+
+
+def test_llm_plan_that_drops_a_named_object_is_sent_back_then_refused(server: FakeOpenAI) -> None:
+    instruction = "put the mouse on the pad, then ring the bell"
+    with_bell = dict(VALID, objects=[*VALID["objects"], {"name": "bell", "type": "bell"}],
+                     subtasks=[*VALID["subtasks"], {"skill": "press", "args": {"obj": "bell"},
+                                                    "description": "the bell was rung",
+                                                    "predicates": [{"name": "pressed", "args": ["bell"]}]}])
+    server.script(json.dumps(VALID), json.dumps(with_bell))
+    plan = _planner(server).plan(instruction)
+    assert [o.type for o in plan.objects] == ["mouse", "mouse_pad", "bell"]
+    repair = server.requests[1]["messages"][-1]["content"]
+    assert "names bell" in repair and "no such object" in repair
+    server.script(*([json.dumps(VALID)] * 3))
+    with pytest.raises(PlanningError, match="names bell"):
+        _planner(server).plan(instruction)

@@ -14,11 +14,16 @@ determiner, a colour, a size or a preposition ("the can", "on the stamp mat"), n
 from __future__ import annotations
 
 import re
+from collections.abc import Iterable
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 from vcage.assets.catalog import CATALOG
 from vcage.errors import PlanningError
 from vcage.planning.language import bounded
+
+if TYPE_CHECKING:
+    from vcage.planning.schema import PlanObject
 
 # spoken names -> catalog types (besides the type names themselves, with spaces)
 ALIASES = {
@@ -213,3 +218,12 @@ def parse_phrase(phrase: str, clause: str) -> ObjectRef:
         raise PlanningError(f"{phrase_q} {where} gives {len(m.colours)} colours; name one")
     return ObjectRef(type=m.type, accepts=m.accepts, colour=m.colours[0] if m.colours else None,
                      size=m.size, sized=m.sized, other=any(w in OTHER for w in ws), text=phrase)
+
+
+def uncovered(text: str, objects: Iterable[PlanObject]) -> list[str]:
+    """The catalog objects ``text`` names that none of ``objects`` is (by type and colour): a plan
+    missing one would carry ``text`` as the label of something else."""
+    objects = tuple(objects)
+    return [m.label() for m in find_mentions(words(text))
+            if not any(m.covered_by(o.type, o.color) for o in objects)]
+

@@ -20,6 +20,7 @@ from vcage.errors import ConfigError, PlanningError
 from vcage.planning.config import MAX_SUBTASKS
 from vcage.planning.goals import GOALS
 from vcage.planning.language import bounded
+from vcage.planning.lexicon import uncovered
 from vcage.planning.schema import Plan, plan_json_schema
 from vcage.vocabulary import PLAN_SKILLS, PREDICATES
 
@@ -89,6 +90,10 @@ class LLMPlanner:
                 data.setdefault("goal", None)
                 data.pop("match", None)  # a goal match is the offline planner's measure, not the model's
                 plan = Plan.model_validate(data)
+                missing = uncovered(text, plan.objects)
+                if missing:  # the plan would carry the instruction as the label of something else
+                    raise ValueError(f"the instruction names {', '.join(missing)}, but the plan has no "
+                                     "such object; every object the instruction names must be in the plan")
             except (ValueError, ValidationError) as exc:
                 errors = _describe(exc)
             else:

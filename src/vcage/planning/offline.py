@@ -42,6 +42,7 @@ from vcage.planning.lexicon import (
     find_mentions,
     listed,
     parse_phrase,
+    uncovered,
     words,
 )
 from vcage.planning.schema import GoalMatch, Plan, PlanObject, Subtask
@@ -400,8 +401,7 @@ class OfflinePlanner:
         return tuple(objs), missing
 
     def _missing(self, text: str, objects: tuple[PlanObject, ...]) -> list[str]:
-        return [m.label() for m in find_mentions(words(text))
-                if not any(m.covered_by(o.type, o.color) for o in objects)]
+        return uncovered(text, objects)
 
     # -- limits and help ---------------------------------------------------------------------------
 
