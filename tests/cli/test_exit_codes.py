@@ -73,3 +73,11 @@ def test_a_corrupt_dataset_exits_5_and_is_never_appended_to(tmp_path: Path) -> N
         result = RUN.invoke(app, verb)
         assert result.exit_code == 5, (verb[0], result.output)
         assert "file-000.mp4" in " ".join(result.output.split()), verb[0]
+
+
+def test_an_output_path_under_a_file_is_bad_input(tmp_path: Path) -> None:
+    a_file = tmp_path / "notes.txt"
+    a_file.write_text("mine")
+    result = RUN.invoke(app, ["generate", "press the bell", "--out", str(a_file / "ds"), *SMALL])
+    assert result.exit_code == 2 and result.output.startswith("error:") and "is a file" in result.output
+    assert a_file.read_text() == "mine"

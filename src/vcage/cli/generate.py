@@ -73,19 +73,27 @@ def generate_cmd(
         "critic": ("VCAGE_VLM", critic_provider, critic_url, critic_model)})
     cfg = cfg.resolved()
     plan = make_planner(cfg.planner).plan(instruction)  # before any progress is shown
-    with Progress(TextColumn("{task.description}"), BarColumn(),
-                  TextColumn("{task.completed}/{task.total}"), TimeElapsedColumn(),
-                  console=console) as bar:
-        job = bar.add_task("episodes", total=episodes)
+    bar = Progress(TextColumn("{task.description}"), BarColumn(),
+                   TextColumn("{task.completed}/{task.total}"), TimeElapsedColumn(), console=console)
+    job = None
 
-        def update(f: object) -> None:
-            from vcage.pipeline.generate import Funnel
+    def update(f: object) -> None:
+        """Shown from the first call on: once everything was checked and the episodes start."""
+        from vcage.pipeline.generate import Funnel
 
-            assert isinstance(f, Funnel)
-            bar.update(job, completed=f.accepted + f.given_up,
-                       description=f"episodes (attempts {f.attempts}, accepted {f.accepted})")
+        nonlocal job
+        assert isinstance(f, Funnel)
+        if job is None:
+            bar.start()
+            job = bar.add_task("episodes", total=f.episodes_requested)
+        bar.update(job, completed=f.accepted + f.given_up,
+                   description=f"episodes (attempts {f.attempts}, accepted {f.accepted})")
 
+    try:
         funnel = generate(instruction, episodes, out, cfg, progress=update, plan=plan, total=total)
+    finally:
+        if job is not None:
+            bar.stop()
     _print_funnel(funnel.to_dict(), out)
     if funnel.accepted < funnel.episodes_requested:
         fail(f"only {funnel.accepted} of the {funnel.episodes_requested} episodes asked for were "

@@ -82,8 +82,15 @@ class DatasetWriter:
         while not parent.exists():
             self._made_dirs.append(parent)
             parent = parent.parent
+        if not parent.is_dir():
+            raise DatasetError(f"{parent} is a file, so {self.root} cannot be made a directory; choose "
+                               "another --out")
         try:
-            self.root.mkdir(parents=True, exist_ok=True)
+            try:
+                self.root.mkdir(parents=True, exist_ok=True)
+            except OSError as exc:
+                raise DatasetError(f"cannot create the dataset directory {self.root}: {exc.strerror}; "
+                                   "choose another --out") from None
             self._lock_fd = lock_dir(self.root)
             if any(self.root.iterdir()):
                 self._open_existing()

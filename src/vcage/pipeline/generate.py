@@ -107,6 +107,8 @@ def generate(instruction: str, episodes: int, out: Path | str, cfg: GenerateConf
         log = _Log(out, writer)
         funnel.episodes_requested = max(0, episodes - writer.num_episodes) if total else episodes
         first = log.next_sample
+        if progress is not None:
+            progress(funnel)  # everything is checked: the episodes start
         for run in pool.runs(plan, cfg, range(first, first + funnel.episodes_requested), critic):
             _record(writer, log, plan, run, funnel)
             funnel.wall = time.perf_counter() - t0
