@@ -14,8 +14,9 @@ import pyarrow.parquet as pq
 import pytest
 
 from vcage.data import DatasetReader, DatasetWriter, Feature
+from vcage.data.repair import repair
 from vcage.data.robomimic import export_robomimic
-from vcage.data.verify import check, repair, verify
+from vcage.data.verify import check, verify
 from vcage.errors import CorruptDatasetError, DatasetError
 
 FPS = 10

@@ -20,7 +20,7 @@ def verify_cmd(path: Path = typer.Argument(..., help="a dataset directory"),
                                            "one to the end and rewrite the metadata (says what it drops)")
                ) -> None:
     """Check every episode's files (decoding the videos) and the metadata; fails if anything is damaged."""
-    from vcage.data.verify import repair as repair_dataset
+    from vcage.data.repair import repair as repair_dataset
     from vcage.data.verify import verify
 
     if repair:

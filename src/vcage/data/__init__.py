@@ -2,7 +2,8 @@
 
 from vcage.data.lerobot import DatasetWriter
 from vcage.data.reader import DatasetReader, Episode, Feature
-from vcage.data.verify import Problem, RepairReport, VerifyReport, check, repair, verify
+from vcage.data.repair import RepairReport, repair
+from vcage.data.verify import Problem, VerifyReport, check, verify
 
 __all__ = ["DatasetReader", "DatasetWriter", "Episode", "Feature", "Problem", "RepairReport", "VerifyReport",
            "check", "repair", "verify"]

@@ -273,7 +273,7 @@ class DatasetWriter:
 
     def _write_marker(self) -> None:
         """``meta/vcage.json``: the format, the config, and ``meta/info.json`` without its totals (so
-        that :func:`vcage.data.verify.repair` can rebuild a damaged ``info.json``)."""
+        that :func:`vcage.data.repair.repair` can rebuild a damaged ``info.json``)."""
         static = {k: v for k, v in self._info(0, 0, 0).items()
                   if k not in ("total_episodes", "total_frames", "total_tasks", "splits")}
         write_json(self.root / layout.VCAGE_PATH, {"format": "vcage/lerobot-v3", "config": self.config,

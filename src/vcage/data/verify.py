@@ -1,13 +1,11 @@
-"""Integrity of a dataset's files, and the repair that drops a damaged tail.
+"""Integrity of a dataset's files (the repair that drops a damaged tail is :mod:`.repair`).
 
 :func:`verify` checks every committed episode against the metadata that describes it: its data
 parquet (readable, the expected rows, index range and frame indices), each camera's MP4 (decoded:
 one frame per row within the episode's time window), its extras JSON and its states ``.npz``
 (loadable, one state per frame), and the metadata itself (``meta/info.json`` totals against the
 episode rows and the tasks). :func:`check` runs the cheap subset that ``vcage inspect``, ``vcage
-audit``, the writer (before it appends) and the robomimic export run. :func:`repair` drops every
-episode from the first damaged one to the end (LeRobot's indices must stay contiguous) and
-rewrites the metadata atomically; it says what it dropped and why.
+audit``, the writer (before it appends) and the robomimic export run.
 
 Only committed episodes are checked: files and rows beyond ``meta/info.json``'s count are a crash's
 leftovers, which the writer removes when it reopens the dataset.
@@ -15,11 +13,9 @@ leftovers, which the writer removes when it reopens the dataset.
 
 from __future__ import annotations
 
-import contextlib
-import os
 import zipfile
 from collections import defaultdict
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -28,20 +24,7 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 
 from vcage.data import layout, video
-from vcage.data import stats as st
-from vcage.data.card import dataset_card
-from vcage.data.files import (
-    TMP_MARK,
-    episode_row,
-    episodes_table,
-    lock_dir,
-    remove_empty_dirs,
-    tasks_table,
-    write_json,
-    write_table,
-    write_text,
-)
-from vcage.data.reader import NPZ_ERRORS, STANDARD_COLUMNS, column_to_numpy, load_json, load_npz, read_parquet
+from vcage.data.reader import NPZ_ERRORS, STANDARD_COLUMNS, load_json, load_npz, read_parquet
 from vcage.errors import CorruptDatasetError, DatasetError
 
 _INFO_KEYS = ("codebase_version", "fps", "total_episodes", "total_frames", "features", "data_path")
@@ -71,7 +54,7 @@ class Problem:
     def where(self) -> str:
         if self.episode is None:
             return "metadata"
-        return _span(self.episode, self.last if self.last is not None else self.episode)
+        return span(self.episode, self.last if self.last is not None else self.episode)
 
     def __str__(self) -> str:
         return f"{self.path} ({self.where}): {self.what}"
@@ -132,8 +115,8 @@ class VerifyReport:
         elif first is None:
             lines.append("no episode is lost; `vcage verify --repair` rewrites the metadata")
         else:
-            keeps = f"keeps {_span(0, first - 1)} and drops" if first else "drops every episode:"
-            lines.append(f"`vcage verify --repair` {keeps} {_span(first, self.episodes - 1)} "
+            keeps = f"keeps {span(0, first - 1)} and drops" if first else "drops every episode:"
+            lines.append(f"`vcage verify --repair` {keeps} {span(first, self.episodes - 1)} "
                          f"({self.healthy_after_first_damaged} of them healthy)")
         return "\n".join(lines)
 
@@ -153,7 +136,7 @@ def verify(root: str | Path) -> VerifyReport:
     one file's content. Raises DatasetError only if ``root`` is not a dataset at all; damage is
     reported, not raised (see :meth:`VerifyReport.raise_if_damaged`).
     """
-    return _Scan(Path(root), decode=True).run().report()
+    return Scan(Path(root), decode=True).run().report()
 
 
 def check(root: str | Path) -> VerifyReport:
@@ -164,10 +147,10 @@ def check(root: str | Path) -> VerifyReport:
     Cost: a few small reads per file; no video is decoded. Catches truncated and missing files;
     damage inside a file that leaves its structure intact needs :func:`verify`.
     """
-    return _Scan(Path(root), decode=False).run().report()
+    return Scan(Path(root), decode=False).run().report()
 
 
-class _Scan:
+class Scan:
     """The state of one pass over a dataset: what the metadata says and what the files hold."""
 
     def __init__(self, root: Path, decode: bool, rebuilt: dict[int, dict[str, Any]] | None = None) -> None:
@@ -200,7 +183,7 @@ class _Scan:
 
     # metadata -------------------------------------------------------------------------------------
 
-    def run(self) -> _Scan:
+    def run(self) -> Scan:
         if self.root.exists() and not self.root.is_dir():
             raise DatasetError(f"{self.root} is a file, not a dataset directory")
         info_path, marker_path = self.root / layout.INFO_PATH, self.root / layout.VCAGE_PATH
@@ -515,7 +498,7 @@ def _npz_shapes(path: Path) -> dict[str, tuple[int, ...]]:
     return out
 
 
-def _span(first: int, last: int) -> str:
+def span(first: int, last: int) -> str:
     return f"episode {first}" if first == last else f"episodes {first}-{last}"
 
 
@@ -542,239 +525,3 @@ def _reason(exc: BaseException) -> str:
 
 
 # repair -------------------------------------------------------------------------------------------
-
-
-@dataclass(frozen=True)
-class RepairReport:
-    """What :func:`repair` did. ``kept``: the episodes the dataset holds now (0..kept-1)."""
-
-    root: Path
-    before: VerifyReport
-    after: VerifyReport
-    kept: int
-    dropped: tuple[int, ...] = ()
-    healthy_dropped: tuple[int, ...] = ()  # dropped only because an earlier episode is damaged
-    rewritten: tuple[str, ...] = ()  # metadata files rewritten
-    removed: tuple[str, ...] = ()  # files deleted
-    reasons: dict[int, list[str]] = field(default_factory=dict)  # dropped damaged episode -> its problems
-    rebuilt: tuple[int, ...] = ()  # kept episodes whose lost metadata row was rebuilt from their files
-
-    @property
-    def changed(self) -> bool:
-        return bool(self.rewritten or self.removed)
-
-    def summary(self) -> str:
-        if not self.changed:
-            return f"{self.root}: nothing to repair; {self.kept} episodes verified"
-        kept = _span(0, self.kept - 1) if self.kept else "no episode"
-        lines = [f"{self.root}: kept {kept}"]
-        if self.dropped:
-            lines[0] += (f", dropped {len(self.dropped)} ({_span(self.dropped[0], self.dropped[-1])}), "
-                         f"{len(self.healthy_dropped)} of them healthy but after a damaged one")
-            for i in sorted(self.reasons):
-                lines += [f"  dropped episode {i}: {why}" for why in self.reasons[i]]
-        if self.rebuilt:
-            lines.append(f"  rebuilt the metadata rows of {_span(self.rebuilt[0], self.rebuilt[-1])} from "
-                         "their files (image statistics from the decoded videos)")
-        if self.rewritten:
-            lines.append(f"  rewrote {', '.join(self.rewritten)}")
-        lines.append(f"  removed {len(self.removed)} files" if self.removed else "  removed no file")
-        lines.append("  verified clean afterwards" if self.after.ok else
-                     f"  still damaged afterwards: {self.after.brief()}")
-        return "\n".join(lines)
-
-
-def repair(root: str | Path) -> RepairReport:
-    """Drop every episode from the first damaged one on, and rewrite the metadata; never silently.
-
-    Holds the writer's lock meanwhile (DatasetError if a writer is appending). Runs :func:`verify`
-    (so it costs a decode of every video, twice: before and after). The episodes before the first
-    damaged one are kept byte for byte; ``meta/info.json`` is rewritten first (the commit point now
-    counts only the kept episodes), then ``stats.json``, ``tasks.parquet``, the episodes files and
-    the card, then the dropped episodes' files are deleted, so a crash midway leaves a dataset that
-    reads as the kept episodes plus leftovers the next writer removes. Damaged metadata alone
-    (``stats.json``, ``tasks.parquet``, the totals in ``info.json``, or ``info.json`` itself when
-    ``meta/vcage.json`` keeps a copy of its layout) is rebuilt from the episode rows.
-
-    Raises CorruptDatasetError if the dataset cannot be repaired this way (``meta/info.json`` lost
-    with no copy, ``meta/vcage.json`` unreadable). The attempt log is not touched: reconcile it with
-    ``kept``.
-    """
-    root = Path(root)
-    if not root.is_dir():
-        raise DatasetError(f"{root} is not a directory; give a dataset directory")
-    fd = lock_dir(root)
-    try:
-        scan = _Scan(root, decode=True).run()
-        before = scan.report()
-        if before.ok:
-            return RepairReport(root, before, before, before.episodes)
-        if scan.marker_damaged:
-            raise CorruptDatasetError(f"cannot repair {root}: {layout.VCAGE_PATH} is damaged, and it holds "
-                                      "the configuration the dataset was made with; restore it from a copy")
-        if scan.static is None or not scan.count_known:
-            lost = ("an episodes metadata file is damaged too, so the number of episodes is unknown"
-                    if scan.static is not None else
-                    f"no copy of its features is kept ({layout.VCAGE_PATH} of datasets written by older "
-                    "versions has none)")
-            raise CorruptDatasetError(f"cannot repair {root}: {layout.INFO_PATH} is damaged and {lost}; "
-                                      "restore it from a copy")
-        rebuilt = _rebuild_rows(scan)
-        if rebuilt:  # an episodes file was lost: check the episodes again with their rebuilt rows
-            scan = _Scan(root, decode=True, rebuilt=rebuilt).run()
-        found = scan.report()
-        kept = found.first_damaged if found.first_damaged is not None else found.episodes
-        return _rewrite(scan, before, found, kept, tuple(i for i in sorted(rebuilt) if i < kept))
-    finally:
-        os.close(fd)
-
-
-def _rewrite(scan: _Scan, before: VerifyReport, found: VerifyReport, kept: int,
-             rebuilt: tuple[int, ...]) -> RepairReport:
-    root, static = scan.root, scan.static
-    assert static is not None
-    rows = [scan.rows[i] for i in range(kept)]
-    tasks = _kept_tasks(scan.tasks, rows)
-    frames = sum(int(r["length"]) for r in rows)
-    info = {**static, "total_episodes": kept, "total_frames": frames, "total_tasks": len(tasks),
-            "splits": {"train": f"0:{kept}"}}
-    rewritten = [layout.INFO_PATH]
-    write_json(root / layout.INFO_PATH, info)  # the commit point first: nothing beyond is read now
-    stats: dict[str, st.Stats] = {}
-    for row in rows:
-        stats = st.merge(stats, st.from_row(row))
-    by_file: dict[str, list[dict[str, Any]]] = defaultdict(list)
-    for i, row in enumerate(rows):
-        by_file[scan.row_files[i]].append(row)
-    removed: list[str] = []
-    if kept:
-        write_json(root / layout.STATS_PATH, st.to_json(stats))
-        write_table(root / layout.TASKS_PATH, tasks_table(tasks))
-        rewritten += [layout.STATS_PATH, layout.TASKS_PATH]
-        for rel, file_rows in sorted(by_file.items()):
-            write_table(root / rel, episodes_table(file_rows))
-            rewritten.append(rel)
-    else:
-        for rel in (layout.STATS_PATH, layout.TASKS_PATH):
-            if (root / rel).exists():
-                (root / rel).unlink()
-                removed.append(rel)
-    if scan.marker is not None:  # a vcage dataset: its card is vcage's (never replace another's README)
-        write_text(root / layout.CARD_PATH, dataset_card(info, tasks))
-        rewritten.append(layout.CARD_PATH)
-    keep = _files_of(scan, range(kept))
-    for path in sorted((root / "meta" / "episodes").glob("chunk-*/file-*.parquet")):
-        rel = path.relative_to(root).as_posix()
-        if rel not in by_file:
-            path.unlink()
-            removed.append(rel)
-    chunks_size = int(static.get("chunks_size") or layout.CHUNKS_SIZE)
-    doomed = _files_of(scan, range(kept, scan.episodes))
-    for path in sorted(root.rglob("*")):
-        if not path.is_file():
-            continue
-        rel = path.relative_to(root).as_posix()
-        index = layout.episode_of_file(rel, chunks_size)
-        stale = (index is not None and index >= kept) or rel in doomed or (
-            path.name.startswith(".") and TMP_MARK in path.name)
-        if stale and rel not in keep:
-            path.unlink()
-            removed.append(rel)
-    for sub in ("data", "videos", "extras", "meta/episodes"):
-        if (root / sub).is_dir():
-            with contextlib.suppress(OSError):
-                remove_empty_dirs(root / sub, keep_root=True)
-    dropped = tuple(range(kept, found.episodes))
-    damaged = set(found.damaged)
-    reasons: dict[int, list[str]] = defaultdict(list)
-    for p in found.problems:
-        for i in p.episodes:
-            reasons[i].append(f"{p.path}: {p.what}")
-    return RepairReport(root, before, verify(root), kept, dropped,
-                        tuple(i for i in dropped if i not in damaged), tuple(rewritten), tuple(removed),
-                        {i: reasons[i] for i in dropped if i in damaged}, rebuilt)
-
-
-def _rebuild_rows(scan: _Scan) -> dict[int, dict[str, Any]]:
-    """Rows for committed episodes whose ``meta/episodes`` row is lost, rebuilt from their files.
-
-    Only for vcage datasets (one episode per file, tasks and ``info.json`` readable), in episode
-    order, up to the first episode whose files do not allow it (that one is damaged). Vector
-    statistics come out exact; image statistics are taken from the decoded video, not the frames
-    the writer saw, so they differ slightly from the lost ones.
-    """
-    static, tasks = scan.static, scan.tasks
-    missing = [i for i in range(scan.episodes) if i not in scan.rows]
-    if not missing or static is None or scan.info is None or scan.marker is None or tasks is None:
-        return {}
-    out: dict[int, dict[str, Any]] = {}
-    for i in missing:
-        before = scan.rows.get(i - 1) or out.get(i - 1)
-        if i and before is None:
-            break
-        start = int(before["dataset_to_index"]) if before is not None else 0
-        try:
-            out[i] = _rebuild_row(scan.root, static, tasks, i, start)
-        except (DatasetError, KeyError, ValueError, TypeError, *NPZ_ERRORS):
-            break
-    return out
-
-
-def _rebuild_row(root: Path, static: dict[str, Any], tasks: list[str], index: int,
-                 start: int) -> dict[str, Any]:
-    chunks_size, fps = int(static.get("chunks_size") or layout.CHUNKS_SIZE), int(static["fps"])
-    chunk, file = divmod(index, chunks_size)
-    table = read_parquet(root / static["data_path"].format(chunk_index=chunk, file_index=file))
-    if set(table.column("episode_index").to_pylist()) != {index}:
-        raise CorruptDatasetError(f"the data file of episode {index} holds other episodes")
-    (task_index,) = set(table.column("task_index").to_pylist())
-    length = table.num_rows
-    cameras = [k for k, f in static["features"].items() if f.get("dtype") == "video"]
-    stats: dict[str, st.Stats] = {}
-    for key, feature in static["features"].items():
-        if feature.get("dtype") != "video" and key not in STANDARD_COLUMNS:
-            stats[key] = st.vector_stats(column_to_numpy(table.column(key)).reshape(length, -1))
-    for key in cameras:
-        frames, _ = video.decode_video(root / static["video_path"].format(video_key=key, chunk_index=chunk,
-                                                                          file_index=file))
-        if len(frames) != length:
-            raise CorruptDatasetError(f"the video {key} of episode {index} has {len(frames)} frames")
-        stats[key] = st.image_stats(frames)
-    for key in STANDARD_COLUMNS:
-        stats[key] = st.vector_stats(table.column(key).to_numpy())
-    extras_path = root / layout.EXTRAS_PATH.format(episode_index=index)
-    extras = load_json(extras_path) if extras_path.exists() else None
-    return episode_row(index, tasks[task_index], length, start, chunks_size=chunks_size, fps=fps,
-                       cameras=cameras, stats=stats, extras=extras if isinstance(extras, dict) else None)
-
-
-def _kept_tasks(tasks: list[str] | None, rows: list[dict[str, Any]]) -> list[str]:
-    """The task list for the kept rows: a prefix of the existing list up to the last task they use
-    (task indices in the data files stay valid), or, when ``tasks.parquet`` is lost, the tasks in
-    order of first appearance (the order the writer gives them)."""
-    used = [str((r.get("tasks") or [""])[0]) for r in rows]
-    if tasks is not None and all(t in tasks for t in used):
-        return tasks[:1 + max((tasks.index(t) for t in used), default=-1)]
-    return list(dict.fromkeys(used))
-
-
-def _files_of(scan: _Scan, episodes: range) -> set[str]:
-    """Relative paths of the data and video files the rows of ``episodes`` point to."""
-    static = scan.static
-    assert static is not None
-    out: set[str] = set()
-    cameras = [k for k, f in static["features"].items() if f.get("dtype") == "video"]
-    for i in episodes:
-        row = scan.rows.get(i)
-        if row is None:
-            continue
-        with contextlib.suppress(KeyError, ValueError, TypeError):
-            out.add(static["data_path"].format(chunk_index=row["data/chunk_index"],
-                                               file_index=row["data/file_index"]))
-        for key in cameras:
-            with contextlib.suppress(KeyError, ValueError, TypeError, AttributeError):
-                out.add(static["video_path"].format(video_key=key,
-                                                    chunk_index=row[f"videos/{key}/chunk_index"],
-                                                    file_index=row[f"videos/{key}/file_index"]))
-    return out
-
