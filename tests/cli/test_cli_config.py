@@ -12,6 +12,7 @@ from backends.fake_openai import FakeOpenAI
 from vcage.cli import app
 from vcage.data import DatasetReader
 from vcage.data.layout import VCAGE_PATH
+from vcage.errors import ConfigError
 
 RUN = CliRunner()
 SMALL = ["--clutter", "1", "--size", "64"]
@@ -68,3 +69,24 @@ def test_the_vlm_endpoint_is_stored_with_the_data_and_the_key_never(
     for path in out.rglob("*"):
         if path.is_file():
             assert secret.encode() not in path.read_bytes(), path
+
+
+def test_timeouts_and_retries_are_options_and_override_a_config_file(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    from vcage.cli.generate import build_config
+
+    monkeypatch.setenv("VCAGE_VLM_MODEL", "env-model")
+    cfg = build_config(None, "vcage", {("critic", "name"): "vlm"},
+                       {"critic": ("VCAGE_VLM", {"timeout": 2.5, "max_retries": 0})})
+    assert cfg.critic is not None and cfg.critic.backend is not None
+    assert (cfg.critic.backend.model, cfg.critic.backend.timeout, cfg.critic.backend.max_retries) == \
+        ("env-model", 2.5, 0)
+    path = tmp_path / "cfg.json"
+    path.write_text(json.dumps(cfg.to_dict()))
+    monkeypatch.delenv("VCAGE_VLM_MODEL")  # the file's endpoint is used, not the environment's
+    again = build_config(path, "vcage", {}, {"critic": ("VCAGE_VLM", {"timeout": 9.0})})
+    assert again.critic is not None and again.critic.backend is not None
+    assert (again.critic.backend.model, again.critic.backend.timeout, again.critic.backend.max_retries) == \
+        ("env-model", 9.0, 0)
+    with pytest.raises(ConfigError, match="timeout"):
+        build_config(path, "vcage", {}, {"critic": ("VCAGE_VLM", {"timeout": -1.0})})

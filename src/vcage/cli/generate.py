@@ -36,11 +36,15 @@ def generate_cmd(
         planner_model: str = typer.Option(None, help="LLM planner's model (else $VCAGE_LLM_MODEL)"),
         planner_url: str = typer.Option(None, help="LLM planner's base URL (else $VCAGE_LLM_BASE_URL)"),
         planner_provider: str = typer.Option(None, help="openai (any compatible server) or gemini"),
+        planner_timeout: float = typer.Option(None, help="seconds per LLM request (default 30)"),
+        planner_retries: int = typer.Option(None, help="retries of a failed LLM request (default 3)"),
         critic: str = typer.Option(None, help="critic that verifies each subtask: image (default, "
                                    "offline), vlm, oracle"),
         critic_model: str = typer.Option(None, help="VLM critic's model (else $VCAGE_VLM_MODEL)"),
         critic_url: str = typer.Option(None, help="VLM critic's base URL (else $VCAGE_VLM_BASE_URL)"),
         critic_provider: str = typer.Option(None, help="openai (any compatible server) or gemini"),
+        critic_timeout: float = typer.Option(None, help="seconds per VLM request (default 30)"),
+        critic_retries: int = typer.Option(None, help="retries of a failed VLM request (default 3)"),
         votes: int = typer.Option(None, help="VLM critic: answers asked per subtask (default 1)"),
         vote_rule: str = typer.Option(None, help="VLM critic: majority (default) or all"),
         placement: str = typer.Option(None, help="context (default), naive or rejection"),
@@ -69,8 +73,11 @@ def generate_cmd(
         ("render", "cameras"): tuple(c.strip() for c in cameras.split(",") if c.strip()) if cameras else None,
         ("render", "size"): (size, size) if size is not None else None,
         ("executor", "name"): executor, ("executor", "workers"): workers, ("executor", "address"): address,
-    }, {"planner": ("VCAGE_LLM", planner_provider, planner_url, planner_model),
-        "critic": ("VCAGE_VLM", critic_provider, critic_url, critic_model)})
+    }, {"planner": ("VCAGE_LLM", {"provider": planner_provider, "base_url": planner_url,
+                                  "model": planner_model, "timeout": planner_timeout,
+                                  "max_retries": planner_retries}),
+        "critic": ("VCAGE_VLM", {"provider": critic_provider, "base_url": critic_url, "model": critic_model,
+                                 "timeout": critic_timeout, "max_retries": critic_retries})})
     cfg = cfg.resolved()
     plan = make_planner(cfg.planner).plan(instruction)  # before any progress is shown
     bar = Progress(TextColumn("{task.description}"), BarColumn(),
@@ -103,11 +110,12 @@ def generate_cmd(
 
 
 def build_config(path: Path | None, mode: str, options: dict[tuple[str, ...], Any],
-                 backends: dict[str, tuple[str, str | None, str | None, str | None]]) -> GenerateConfig:
+                 backends: dict[str, tuple[str, dict[str, Any]]]) -> GenerateConfig:
     """The run's configuration tree: a file or a preset, then every option given on the command line.
 
     ``options`` maps a field's path in the tree to its value (None: not given); ``backends`` maps
-    ``planner``/``critic`` to (environment prefix, provider, base URL, model) given for its endpoint.
+    ``planner``/``critic`` to (environment prefix, the endpoint's fields given: provider, base URL,
+    model, timeout, retries); fields not given come from the environment.
     """
     from vcage.backends import BackendConfig
     from vcage.pipeline.config import GenerateConfig
@@ -133,12 +141,15 @@ def build_config(path: Path | None, mode: str, options: dict[tuple[str, ...], An
                     node[key] = {}
                 node = node[key]
             node[keys[-1]] = value
-    for part, (prefix, provider, url, model) in backends.items():
-        given = {k: v for k, v in (("provider", provider), ("base_url", url), ("model", model)) if v}
+    for part, (prefix, fields) in backends.items():
+        given = {k: v for k, v in fields.items() if v is not None}
         if given:
             if tree.get(part) is None:
                 raise ConfigError(f"--{part}-* options need a {part} (Vanilla runs have no critic)")
-            tree[part]["backend"] = BackendConfig.from_env(prefix, None, **given).to_dict()
+            if tree[part].get("backend"):  # from the --config file: the options override its fields
+                tree[part]["backend"].update(given)
+            else:
+                tree[part]["backend"] = BackendConfig.from_env(prefix, None, **given).to_dict()
     return GenerateConfig.from_dict(tree)
 
 
