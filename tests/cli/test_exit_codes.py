@@ -6,22 +6,11 @@ from pathlib import Path
 
 from typer.testing import CliRunner
 
+import scripted_critics  # noqa: F401  (registers reject_all)
 from vcage.cli import app
-from vcage.critics import CRITICS, Critic, Observation, Verdict
 
 RUN = CliRunner()
 SMALL = ["--clutter", "0", "--size", "64", "--cameras", "front"]
-
-
-class Never(Critic):
-    needs_views = False
-
-    def judge(self, obs: Observation) -> Verdict:
-        return Verdict(False, "rejects everything")
-
-
-if "reject_all" not in CRITICS:
-    CRITICS.add("reject_all", lambda config: Never())
 
 
 def test_nothing_accepted_exits_3_and_writes_nothing(tmp_path: Path) -> None:

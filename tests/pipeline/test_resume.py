@@ -8,8 +8,9 @@ from pathlib import Path
 
 import pytest
 
+import scripted_critics  # noqa: F401  (registers alternating and reject_all)
 from vcage.config import RenderConfig
-from vcage.critics import CRITICS, Critic, CriticConfig, Observation, Verdict
+from vcage.critics import CriticConfig
 from vcage.data import DatasetReader
 from vcage.data.layout import ATTEMPTS_LOG, RUNS_LOG
 from vcage.pipeline.attempt_log import read
@@ -19,25 +20,6 @@ from vcage.pipeline.generate import generate
 from vcage.scene.instantiate import SceneConfig
 
 SHORT = "press the bell"
-
-
-class Alternating(Critic):
-    """Accepts, rejects, accepts, ... in call order: a given-up episode on demand (one subtask,
-    one attempt per episode)."""
-
-    name = "alternating"
-    needs_views = False
-
-    def __init__(self) -> None:
-        self.calls = 0
-
-    def judge(self, obs: Observation) -> Verdict:
-        self.calls += 1
-        return Verdict(self.calls % 2 == 1, f"call {self.calls}")
-
-
-if "alternating" not in CRITICS:
-    CRITICS.add("alternating", lambda config: Alternating())
 
 
 def _cfg(critic: str = "oracle", attempts: int = 3) -> GenerateConfig:
@@ -101,16 +83,7 @@ def test_the_log_is_reconciled_with_the_dataset_when_reopened(tmp_path: Path) ->
 
 def test_nothing_accepted_is_a_partial_result_and_writes_nothing(tmp_path: Path) -> None:
     out = tmp_path / "ds"
-
-    class Never(Critic):
-        needs_views = False
-
-        def judge(self, obs: Observation) -> Verdict:
-            return Verdict(False, "never")
-
-    if "never" not in CRITICS:
-        CRITICS.add("never", lambda config: Never())
-    funnel = generate(SHORT, 2, out, _cfg("never", attempts=2))
+    funnel = generate(SHORT, 2, out, _cfg("reject_all", attempts=2))
     assert (funnel.accepted, funnel.given_up, funnel.attempts, funnel.dataset_episodes) == (0, 2, 4, 0)
     assert funnel.stages == {"critic": 4}
     assert not out.exists()  # nothing is persisted before a first episode commits
