@@ -95,3 +95,17 @@ def test_episodes_must_be_positive_unless_total(tmp_path: Path) -> None:
     with pytest.raises(ConfigError, match="episodes"):
         generate(SHORT, 0, tmp_path / "ds", _cfg())
     assert not (tmp_path / "ds").exists()
+
+
+def test_audit_refuses_a_corrupt_log_that_a_writer_would_reconcile(tmp_path: Path) -> None:
+    from vcage.errors import DatasetError
+
+    out = tmp_path / "ds"
+    generate(SHORT, 1, out, _cfg())
+    log = out / ATTEMPTS_LOG
+    clean = log.read_text()
+    log.write_text(clean + '{"episode": 1, "att')  # torn while appending
+    with pytest.raises(DatasetError, match="line 2 is not JSON"):
+        audit(out)  # the audit reports it; it does not guess
+    generate(SHORT, 1, out, _cfg(), total=True)  # reopening for writing drops the torn line
+    assert log.read_text() == clean and audit(out).accepted == 1

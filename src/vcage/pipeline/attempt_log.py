@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import json
 from collections.abc import Iterable
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -25,39 +24,31 @@ from vcage.pipeline.stage import Stage
 Record = dict[str, Any]
 
 
-def read(path: Path) -> list[Record]:
-    """The records of the log at ``path`` ([] if absent); a torn last line is ignored."""
-    if not path.is_file():
-        return []
-    lines = path.read_text().splitlines()
+def read(path: Path, torn_tail: bool = True) -> list[Record]:
+    """The records of the JSON-lines file at ``path`` ([] if absent). With ``torn_tail`` a last line
+    that is not JSON (a crash while appending) is ignored; any other such line is corruption."""
+    return _parse(path, path.read_text() if path.is_file() else "", torn_tail)
+
+
+def _parse(path: Path, text: str, torn_tail: bool) -> list[Record]:
+    lines = text.splitlines()
     records = []
     for n, line in enumerate(lines, 1):
         try:
             records.append(json.loads(line))
         except json.JSONDecodeError:
-            if n == len(lines):  # a crash while appending: the line was never complete
+            if torn_tail and n == len(lines):  # the line was never complete
                 break
-            raise DatasetError(f"{path} line {n} is not JSON; the attempt log is corrupt") from None
+            raise DatasetError(f"{path} line {n} is not JSON; the log is corrupt") from None
     return records
 
 
-@dataclass(frozen=True)
-class Reconciled:
-    records: list[Record]
-    restored: int  # lines of committed episodes that were missing and are now appended
-    dropped: int  # lines of episodes the dataset does not hold, removed
-
-    @property
-    def next_sample(self) -> int:
-        """The first sample index no attempt has used: where the next run continues."""
-        return 1 + max((int(r["episode"]) for r in self.records), default=-1)
-
-
-def reconcile(path: Path, committed: Iterable[dict[str, Any]]) -> Reconciled:
-    """Make the log at ``path`` match the committed episodes' extras ``committed``; rewrite it
-    atomically if anything changed."""
-    records = read(path)
+def reconcile(path: Path, committed: Iterable[dict[str, Any]]) -> int:
+    """Make the log at ``path`` match the committed episodes' extras ``committed`` (rewritten
+    atomically if anything changed); returns the first sample index no attempt has used, where the
+    next run continues."""
     raw = path.read_text() if path.is_file() else ""
+    records = _parse(path, raw, torn_tail=True)
     committed = list(committed)
     held = {int(e["seed"]) for e in committed}
     orphans = {int(r["episode"]) for r in records
@@ -69,7 +60,7 @@ def reconcile(path: Path, committed: Iterable[dict[str, Any]]) -> Reconciled:
     text = "".join(json.dumps(r) + "\n" for r in kept)
     if text != raw:
         atomic_write(path, lambda tmp: tmp.write_text(text))
-    return Reconciled(kept, len(restored), len(records) - (len(kept) - len(restored)))
+    return 1 + max((int(r["episode"]) for r in kept), default=-1)
 
 
 def append(path: Path, records: Iterable[Record]) -> None:

@@ -7,13 +7,13 @@ agreement compares the critic's per-subtask verdicts with the oracle's (accept =
 
 from __future__ import annotations
 
-import json
 from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any
 
 from vcage.data.layout import ATTEMPTS_LOG
 from vcage.errors import DatasetError
+from vcage.pipeline.attempt_log import read
 from vcage.pipeline.stage import Stage
 
 
@@ -70,11 +70,7 @@ def audit(root: Path) -> AuditReport:
                            "attempt log was removed")
     counts = dict.fromkeys(("attempts", "accepted", "accepted_oracle_failed", "judged_subtasks",
                             "true_accept", "false_accept", "false_reject", "true_reject"), 0)
-    for n, line in enumerate(path.read_text().splitlines(), 1):
-        try:
-            rec = json.loads(line)
-        except json.JSONDecodeError:
-            raise DatasetError(f"{path} line {n} is not JSON; the log is corrupt") from None
+    for rec in read(path, torn_tail=False):
         counts["attempts"] += 1
         if rec["stage"] == Stage.ACCEPTED:
             counts["accepted"] += 1

@@ -131,7 +131,7 @@ class _Log:
         if writer.num_episodes:
             reader = DatasetReader(out)
             committed = [reader.extras(i) for i in range(reader.num_episodes)]
-        self.next_sample = attempt_log.reconcile(self.path, committed).next_sample
+        self.next_sample = attempt_log.reconcile(self.path, committed)
         self.pending: list[dict[str, Any]] = []
 
     def add(self, records: list[dict[str, Any]]) -> None:
