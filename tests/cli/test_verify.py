@@ -27,7 +27,10 @@ def text(result: object) -> str:
 
 
 def make(root: Path, episodes: int = 3) -> None:
-    with DatasetWriter(root, fps=10, features=FEATURES, cameras={CAM: (16, 16)}, config={"k": 1}) as w:
+    """Files of a byte at most: each episode's data and video in files of their own, so that one
+    truncated file damages one episode (tests/data/test_packing.py covers shared files)."""
+    with DatasetWriter(root, fps=10, features=FEATURES, cameras={CAM: (16, 16)}, config={"k": 1},
+                       data_files_size_in_mb=1e-6, video_files_size_in_mb=1e-6) as w:
         for i in range(episodes):
             n = 4 + i
             w.add_episode({"observation.state": np.zeros((n, 2), np.float32),

@@ -28,8 +28,10 @@ LENGTHS = (8, 6, 7, 5)
 
 
 def open_writer(root: Path) -> DatasetWriter:
+    """Files of at most a byte: every episode gets files of its own, so each damage below costs one
+    episode (tests/data/test_packing.py damages files that episodes share)."""
     return DatasetWriter(root, fps=FPS, features=FEATURES, cameras={CAM: (32, 32)}, robot_type="panda",
-                         config=CONFIG)
+                         config=CONFIG, data_files_size_in_mb=1e-6, video_files_size_in_mb=1e-6)
 
 
 def add(w: DatasetWriter, length: int, seed: int) -> int:
@@ -148,7 +150,8 @@ def test_a_time_window_that_disagrees_with_the_video_is_found_by_decoding(ds: Pa
 
 def test_repair_across_chunks_removes_the_dropped_chunks(tmp_path: Path) -> None:
     root = tmp_path / "ds"
-    with DatasetWriter(root, fps=FPS, features=FEATURES, config=CONFIG, chunks_size=2) as w:
+    with DatasetWriter(root, fps=FPS, features=FEATURES, config=CONFIG, chunks_size=2,
+                       data_files_size_in_mb=1e-6) as w:  # a data file per episode: 3 chunks
         for i in range(5):
             w.add_episode({"observation.state": np.zeros((3, 4), np.float32),
                            "action": np.zeros((3, 3), np.float32)}, task="t", extras={"seed": i})

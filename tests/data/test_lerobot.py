@@ -3,17 +3,18 @@
 from __future__ import annotations
 
 import json
-import shutil
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pyarrow as pa
+import pyarrow.compute
 import pyarrow.parquet as pq
 import pytest
 
 from vcage.data import DatasetReader, DatasetWriter, Feature
 from vcage.data import video as video_mod
+from vcage.data.verify import verify
 from vcage.errors import DatasetError
 
 FPS = 20
@@ -107,26 +108,33 @@ def test_layout_files_and_columns(three: tuple[Path, list[Any]]) -> None:
                      {"task_index": 1, "task": "stack the blocks"}]
     task_of = {t["task_index"]: t["task"] for t in tasks}
 
-    all_index = []
+    # packed as LeRobot packs them: the three episodes share one data file and one mp4 per camera
+    assert listing(root / "data") == ["chunk-000/file-000.parquet"]
+    for key in CAMS:
+        assert listing(root / "videos" / key) == ["chunk-000/file-000.mp4"]
+    table = pq.read_table(root / "data/chunk-000/file-000.parquet")
+    assert set(table.column_names) == set(FEATURES) | STANDARD
+    assert table.schema.field("observation.state").type == pa.list_(pa.float32(), 9)
+    assert table.schema.field("timestamp").type == pa.float32()
+    all_index, start = [], 0
     for row, (length, task, *_rest) in zip(rows, inputs, strict=True):
-        data = root / info["data_path"].format(chunk_index=row["data/chunk_index"],
-                                               file_index=row["data/file_index"])
+        assert (row["data/chunk_index"], row["data/file_index"]) == (0, 0)
         for key in CAMS:
-            mp4 = root / info["video_path"].format(video_key=key,
-                                                   chunk_index=row[f"videos/{key}/chunk_index"],
-                                                   file_index=row[f"videos/{key}/file_index"])
-            assert mp4.is_file()
-            assert row[f"videos/{key}/to_timestamp"] == pytest.approx(length / FPS)
-        table = pq.read_table(data)
-        assert set(table.column_names) == set(FEATURES) | STANDARD
-        assert table.schema.field("observation.state").type == pa.list_(pa.float32(), 9)
-        assert table.schema.field("timestamp").type == pa.float32()
-        frame_index = table.column("frame_index").to_numpy()
+            assert (row[f"videos/{key}/chunk_index"], row[f"videos/{key}/file_index"]) == (0, 0)
+            assert row[f"videos/{key}/from_timestamp"] == pytest.approx(start / FPS)
+            assert row[f"videos/{key}/to_timestamp"] == pytest.approx((start + length) / FPS)
+        mine = table.filter(pa.compute.equal(table.column("episode_index"), row["episode_index"]))
+        frame_index = mine.column("frame_index").to_numpy()
         np.testing.assert_array_equal(frame_index, np.arange(length))
-        np.testing.assert_allclose(table.column("timestamp").to_numpy(), frame_index / FPS, rtol=1e-6)
-        assert set(table.column("episode_index").to_pylist()) == {row["episode_index"]}
-        assert {task_of[t] for t in table.column("task_index").to_pylist()} == {task} == set(row["tasks"])
-        all_index += table.column("index").to_pylist()
+        np.testing.assert_allclose(mine.column("timestamp").to_numpy(), frame_index / FPS, rtol=1e-6)
+        assert {task_of[t] for t in mine.column("task_index").to_pylist()} == {task} == set(row["tasks"])
+        all_index += mine.column("index").to_pylist()
+        start += length
+    np.testing.assert_array_equal(table.column("episode_index").to_numpy(),
+                                  np.repeat([0, 1, 2], [20, 15, 20]))
+    for key in CAMS:  # one frame per row, in episode order
+        frames, times = video_mod.decode_video(root / f"videos/{key}/chunk-000/file-000.mp4")
+        assert len(frames) == 55 and np.allclose(times, np.arange(55) / FPS)
     assert all_index == list(range(55))
     assert (root / "extras/episode_000001.json").is_file()
     assert (root / "extras/episode_000001_states.npz").is_file()
@@ -279,11 +287,12 @@ def test_bad_construction_refused(tmp_path: Path) -> None:
     assert not (tmp_path / "a").exists() and not (tmp_path / "b").exists()
 
 
-@pytest.mark.parametrize("fail_at", ["second video", "commit"])
+@pytest.mark.parametrize("fail_at", ["second video", "joining a video", "commit"])
 def test_failed_episode_keeps_earlier_episodes(three: tuple[Path, list[Any]], fail_at: str,
                                                 monkeypatch: pytest.MonkeyPatch) -> None:
+    """A failure before, while and after the shared files are rewritten leaves them byte for byte."""
     root, inputs = three
-    before = listing(root)
+    before = contents(root)
     w = writer(root)
     if fail_at == "second video":
         real = video_mod.encode_video
@@ -296,6 +305,14 @@ def test_failed_episode_keeps_earlier_episodes(three: tuple[Path, list[Any]], fa
             real(path, frames, fps, encoder)
 
         monkeypatch.setattr(video_mod, "encode_video", flaky)
+    elif fail_at == "joining a video":  # the data file is already replaced by then
+        real_concat = video_mod.concat_videos
+
+        def flaky_concat(sources: list[tuple[Path, int]], out: Path, fps: int) -> None:
+            real_concat(sources, out, fps)
+            raise OSError("disk full")
+
+        monkeypatch.setattr(video_mod, "concat_videos", flaky_concat)
     else:
         def broken_info(episodes: int, frames: int, tasks: int) -> None:
             raise OSError("disk full")
@@ -304,7 +321,7 @@ def test_failed_episode_keeps_earlier_episodes(three: tuple[Path, list[Any]], fa
     frames, videos = episode(12, seed=5)
     with pytest.raises(OSError, match="disk full"):
         w.add_episode(frames, videos, task="a new task", extras={"seed": 5}, arrays={"s": np.zeros(3)})
-    assert listing(root) == before  # no stray final files, no temp files
+    assert contents(root) == before  # the shared files put back, no stray files, no temp files
     reader = DatasetReader(root)
     assert reader.num_episodes == 3 and len(reader.tasks) == 2
     np.testing.assert_array_equal(reader.episode(2).frames["action"], inputs[2][2]["action"])
@@ -314,31 +331,42 @@ def test_failed_episode_keeps_earlier_episodes(three: tuple[Path, list[Any]], fa
     assert DatasetReader(root).episode(3).frames["index"][0] == 55
 
 
+def contents(root: Path) -> dict[str, bytes]:
+    return {p.relative_to(root).as_posix(): p.read_bytes() for p in sorted(root.rglob("*")) if p.is_file()}
+
+
 def test_crash_leftovers_ignored_then_removed(three: tuple[Path, list[Any]]) -> None:
-    """A crash after some files of episode 3 landed but before the commit (info.json)."""
+    """A crash after episode 3 had replaced the shared files (keeping backups of the committed
+    bytes) and started files of its own, but before the commit (info.json)."""
     root, _ = three
-    committed = snapshot(root)
-    shutil.copy(root / "data/chunk-000/file-002.parquet", root / "data/chunk-000/file-003.parquet")
-    cam_dir = root / "videos" / CAMS[0] / "chunk-000"
-    shutil.copy(cam_dir / "file-002.mp4", cam_dir / "file-003.mp4")
+    committed = contents(root)
+    shared = [root / "data/chunk-000/file-000.parquet",
+              *(root / "videos" / key / "chunk-000/file-000.mp4" for key in CAMS)]
+    for path in shared:  # what the writer does before it replaces a shared file
+        path.with_name(f".{path.name}.keep-000003").hardlink_to(path)
+        path.unlink()
+        path.write_bytes(b"the shared file with episode 3 appended")
+    (root / "data/chunk-000/file-001.parquet").write_bytes(b"a file episode 3 started")
     (root / "data/chunk-000/.file-004.parquet.tmp-1-abcd").write_bytes(b"partial")
     (root / "extras/episode_000003.json").write_text("{}")
     episodes_file = root / "meta/episodes/chunk-000/file-000.parquet"
     rows = pq.read_table(episodes_file).to_pylist()
     pq.write_table(pa.Table.from_pylist(rows + [rows[-1] | {"episode_index": 3}]), episodes_file)
-    reader = DatasetReader(root)
-    assert reader.num_episodes == 3 and reader.episode(2).length == 20
+    assert verify(root).ok  # the committed bytes are checked, in the backups
     with writer(root) as w:
-        assert set(snapshot(root)) == set(committed)  # leftovers gone
+        after = contents(root)
+        assert set(after) == set(committed) and all(after[k] == committed[k] for k in after
+                                                     if not k.startswith("meta/episodes"))
         frames, videos = episode(8, seed=3)
         assert w.add_episode(frames, videos, task="stack the blocks") == 3
     reader = DatasetReader(root)
     assert reader.num_episodes == 4 and reader.episode(3).length == 8 and len(reader.tasks) == 2
+    assert verify(root).ok and not list(root.rglob(".*keep-*"))
 
 
 def _corrupt_cases() -> list[tuple[str, str]]:
-    return [("missing info", "info.json"), ("bad info", "info.json"), ("missing data", "file-001.parquet"),
-            ("missing video", "file-002.mp4"), ("count mismatch", "info.json"),
+    return [("missing info", "info.json"), ("bad info", "info.json"), ("missing data", "file-000.parquet"),
+            ("missing video", "file-000.mp4"), ("count mismatch", "info.json"),
             ("bad episodes", "meta/episodes/chunk-000/file-000.parquet"), ("missing tasks", "tasks.parquet")]
 
 
@@ -351,9 +379,9 @@ def test_corrupt_dataset_raises_naming_the_file(three: tuple[Path, list[Any]], c
     elif case == "bad info":
         info_path.write_text("{not json")
     elif case == "missing data":
-        (root / "data/chunk-000/file-001.parquet").unlink()
+        (root / "data/chunk-000/file-000.parquet").unlink()
     elif case == "missing video":
-        (root / "videos" / CAMS[1] / "chunk-000/file-002.mp4").unlink()
+        (root / "videos" / CAMS[1] / "chunk-000/file-000.mp4").unlink()
     elif case == "count mismatch":
         info_path.write_text(json.dumps(json.loads(info_path.read_text()) | {"total_episodes": 4}))
     elif case == "bad episodes":
@@ -366,14 +394,14 @@ def test_corrupt_dataset_raises_naming_the_file(three: tuple[Path, list[Any]], c
 
 def test_unreadable_episode_files_raise_on_read(three: tuple[Path, list[Any]]) -> None:
     root, _ = three
-    (root / "data/chunk-000/file-001.parquet").write_bytes(b"not parquet")
-    (root / "videos" / CAMS[0] / "chunk-000/file-002.mp4").write_bytes(b"not a video")
+    (root / "videos" / CAMS[0] / "chunk-000/file-000.mp4").write_bytes(b"not a video")
     reader = DatasetReader(root)
-    with pytest.raises(DatasetError, match="file-001.parquet"):
-        reader.episode(1)
-    with pytest.raises(DatasetError, match="file-002.mp4"):
+    with pytest.raises(DatasetError, match="file-000.mp4"):
         reader.video(2, CAMS[0])
-    assert reader.episode(0).length == 20
+    assert reader.episode(0).length == 20 and len(reader.video(1, CAMS[1])) == 15
+    (root / "data/chunk-000/file-000.parquet").write_bytes(b"not parquet")
+    with pytest.raises(DatasetError, match="file-000.parquet"):
+        reader.episode(1)
 
 
 def test_video_timestamps_and_sizes(tmp_path: Path) -> None:
@@ -399,9 +427,10 @@ def test_every_available_encoder_round_trips(tmp_path: Path, encoder: str) -> No
 
 
 def test_chunks_without_cameras(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
-    """chunks_size=2: episode 2 opens chunk 1; a failure there leaves chunk 0 alone; append works."""
+    """chunks_size=2 and a file per episode: episode 2 opens chunk 1; a failure there leaves chunk 0
+    alone; append works (and keeps the dataset's file size, not the writer's default)."""
     root = tmp_path / "ds"
-    with writer(root, cameras={}, chunks_size=2) as w:
+    with writer(root, cameras={}, chunks_size=2, data_files_size_in_mb=1e-6) as w:
         for i in range(2):
             w.add_episode(episode(5 + i, seed=i)[0], task="t")
         before = listing(root)

@@ -1,9 +1,10 @@
 """Fault injection: ``kill -9`` at many points of a generation run, then the same command again.
 
-Whatever the kill interrupted (simulation, video encoding, the files of an episode, the meta
-files, the commit, the attempt log), rerunning ``vcage generate ... --total`` must leave a dataset
-that verifies clean, holds exactly the episodes asked for, byte for byte the episodes of an
-uninterrupted run, and an attempt log that matches it.
+Whatever the kill interrupted (simulation, video encoding, the files of an episode, the shared
+data and video files the second episode joins, the meta files, the commit, the attempt log),
+rerunning ``vcage generate ... --total`` must leave a dataset that verifies clean, holds exactly
+the episodes asked for, byte for byte the episodes of an uninterrupted run, and an attempt log
+that matches it.
 """
 
 from __future__ import annotations
@@ -29,6 +30,9 @@ TIMED_KILLS = 10  # at evenly spread moments of the run
 # each episode's data, video, extras and states, then some meta files)
 WINDOW_KILLS = ((1, 0.0), (2, 0.0), (3, 0.0), (4, 0.0), (5, 0.0), (6, 0.0), (7, 0.0), (2, 0.003),
                 (4, 0.003), (6, 0.003))
+# while the second episode, which joins the first one's data and video files, replaces them: right
+# after the first backup of a shared file appears (it lives until the episode commits), or later
+BACKUP_KILLS = (0.0, 0.002, 0.005)
 COMPARED = ("*.parquet", "*.mp4", "*.npz")
 
 
@@ -43,22 +47,22 @@ def _run(out: Path) -> subprocess.CompletedProcess[str]:
                           env={**os.environ, "COLUMNS": "200"})
 
 
-def _temporaries(root: Path) -> set[str]:
+def _temporaries(root: Path, mark: str = ".tmp-") -> set[str]:
     if not root.exists():
         return set()
-    return {os.path.join(d, f) for d, _, files in os.walk(root) for f in files if ".tmp-" in f}
+    return {os.path.join(d, f) for d, _, files in os.walk(root) for f in files if mark in f}
 
 
 def _kill(proc: subprocess.Popen[bytes], out: Path, at: float | None, nth_temporary: int,
-          delay: float = 0.0) -> str:
-    """SIGKILL ``proc`` at ``at`` seconds, or ``delay`` after it created ``nth_temporary`` temporary
-    files."""
+          delay: float = 0.0, mark: str = ".tmp-") -> str:
+    """SIGKILL ``proc`` at ``at`` seconds, or ``delay`` after it created ``nth_temporary`` files
+    whose names hold ``mark`` (temporary files, or backups)."""
     start, seen = time.perf_counter(), set()
     while proc.poll() is None:
         if at is not None and time.perf_counter() - start >= at:
             break
         if at is None:
-            seen |= _temporaries(out)
+            seen |= _temporaries(out, mark)
             if len(seen) >= nth_temporary:
                 time.sleep(delay)
                 break
@@ -76,6 +80,8 @@ def reference(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, float]:
     t0 = time.perf_counter()
     done = _run(out)
     assert done.returncode == 0, done.stdout + done.stderr
+    shared = sorted(p.name for p in out.rglob("file-*.*") if "meta" not in p.parts)
+    assert shared == ["file-000.mp4", "file-000.parquet"]  # the second episode joined the first's files
     return out, time.perf_counter() - t0
 
 
@@ -83,7 +89,7 @@ def _files(root: Path) -> dict[str, bytes]:
     return {str(p.relative_to(root)): p.read_bytes() for pattern in COMPARED for p in root.rglob(pattern)}
 
 
-@pytest.mark.parametrize("trial", range(TIMED_KILLS + len(WINDOW_KILLS)))
+@pytest.mark.parametrize("trial", range(TIMED_KILLS + len(WINDOW_KILLS) + len(BACKUP_KILLS)))
 def test_kill_9_then_rerun_completes_the_same_dataset(trial: int, tmp_path: Path,
                                                       reference: tuple[Path, float]) -> None:
     clean, seconds = reference
@@ -91,9 +97,12 @@ def test_kill_9_then_rerun_completes_the_same_dataset(trial: int, tmp_path: Path
     proc = subprocess.Popen(_command(out), stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     if trial < TIMED_KILLS:  # from start-up to late in the second episode
         outcome = _kill(proc, out, at=0.3 + 0.7 * seconds * trial / TIMED_KILLS, nth_temporary=0)
-    else:
+    elif trial < TIMED_KILLS + len(WINDOW_KILLS):
         nth, delay = WINDOW_KILLS[trial - TIMED_KILLS]
         outcome = _kill(proc, out, at=None, nth_temporary=nth, delay=delay)
+    else:
+        delay = BACKUP_KILLS[trial - TIMED_KILLS - len(WINDOW_KILLS)]
+        outcome = _kill(proc, out, at=None, nth_temporary=1, delay=delay, mark=".keep-")
     assert outcome == "killed"  # the kill landed while the run was going on
     rerun = _run(out)
     if rerun.returncode == 5:  # killed between an episode's meta rows and its commit: the documented path
@@ -112,4 +121,5 @@ def test_kill_9_then_rerun_completes_the_same_dataset(trial: int, tmp_path: Path
     log = read(out / ATTEMPTS_LOG)
     assert sorted(r["seed"] for r in log if r["stage"] == "accepted") == sorted(seeds)
     assert log == read(clean / ATTEMPTS_LOG)
-    assert not _temporaries(out) and not (out / "meta" / ".vcage.lock").exists()
+    assert not _temporaries(out) and not _temporaries(out, ".keep-")
+    assert not (out / "meta" / ".vcage.lock").exists()

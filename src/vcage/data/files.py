@@ -6,6 +6,8 @@ from __future__ import annotations
 import fcntl
 import json
 import os
+import re
+import shutil
 import uuid
 from collections.abc import Callable
 from pathlib import Path
@@ -20,6 +22,8 @@ from vcage.data.layout import PROVENANCE
 from vcage.errors import DatasetError
 
 TMP_MARK = ".tmp-"  # temporary files are named .<name>.tmp-<pid>-<random>
+BACKUP_MARK = ".keep-"  # .<name>.keep-<n>: the file as it was with n episodes committed
+_BACKUP = re.compile(r"^\.(.+)\.keep-(\d+)$")
 
 
 def _fsync(path: Path) -> None:
@@ -30,16 +34,79 @@ def _fsync(path: Path) -> None:
         os.close(fd)
 
 
+def scratch(path: Path) -> Path:
+    """A temporary name next to ``path`` (hidden, marked with TMP_MARK: a crash's leftover that the
+    next writer removes)."""
+    return path.with_name(f".{path.name}{TMP_MARK}{os.getpid()}-{uuid.uuid4().hex[:8]}")
+
+
 def atomic_write(path: Path, write: Callable[[Path], object]) -> None:
     """Call ``write(tmp)`` on a temporary name next to ``path``, then move it into place."""
     path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.name}{TMP_MARK}{os.getpid()}-{uuid.uuid4().hex[:8]}")
+    tmp = scratch(path)
     try:
         write(tmp)
         _fsync(tmp)
         os.replace(tmp, path)
     finally:
         tmp.unlink(missing_ok=True)
+
+
+def backup_path(path: Path, committed: int) -> Path:
+    return path.with_name(f".{path.name}{BACKUP_MARK}{committed:06d}")
+
+
+def keep_backup(path: Path, committed: int) -> Path:
+    """Keep the bytes of ``path`` (a file that holds ``committed`` episodes' content and is about to be
+    replaced by one holding another episode too) under :func:`backup_path`, so that the replacement
+    can be undone if that episode never commits. A hard link where the file system allows it (no
+    copy), else a copy."""
+    backup = backup_path(path, committed)
+    backup.unlink(missing_ok=True)
+    try:
+        os.link(path, backup)
+    except OSError:
+        tmp = scratch(backup)
+        try:
+            shutil.copyfile(path, tmp)
+            _fsync(tmp)
+            os.replace(tmp, backup)
+        finally:
+            tmp.unlink(missing_ok=True)
+    return backup
+
+
+def settle_backups(root: Path, committed: int) -> list[Path]:
+    """Resolve the backups under ``root`` against the commit point: a backup taken for episode ``n``
+    (it holds the file as it was before that episode) is moved back over its file when ``n`` never
+    committed (``n >= committed``), else deleted. Returns the files restored."""
+    restored = []
+    for backup in sorted(root.rglob(f".*{BACKUP_MARK}*")):
+        match = _BACKUP.match(backup.name)
+        if match is None or not backup.is_file():
+            continue
+        original = backup.with_name(match.group(1))
+        if int(match.group(2)) >= committed:
+            restore_backup(backup, original)
+            restored.append(original)
+        else:
+            backup.unlink()
+    return restored
+
+
+def restore_backup(backup: Path, original: Path) -> None:
+    """Put a backup's bytes back at ``original`` (atomically) and remove the backup."""
+    if original.exists() and os.path.samefile(backup, original):
+        backup.unlink()  # never replaced: rename() between two links of one file would do nothing
+    else:
+        os.replace(backup, original)
+
+
+def committed_version(path: Path, committed: int) -> Path:
+    """The file holding what ``path`` held at the commit point: its backup if a write of episode
+    ``committed`` (which never committed) replaced it and left one, else ``path`` itself."""
+    backup = backup_path(path, committed)
+    return backup if backup.is_file() else path
 
 
 def write_text(path: Path, text: str) -> None:
@@ -148,20 +215,25 @@ def provenance(extras: dict[str, Any] | None) -> dict[str, Any]:
     return out
 
 
-def episode_row(index: int, task: str, length: int, start: int, *, chunks_size: int, fps: int,
-                cameras: list[str], stats: dict[str, dict[str, np.ndarray]],
-                extras: dict[str, Any] | None) -> dict[str, Any]:
-    """The ``meta/episodes`` row of episode ``index`` as vcage lays it out (one episode per file),
-    whose frames start at dataset index ``start``; ``stats`` are its per-episode statistics."""
-    chunk, file = divmod(index, chunks_size)
+def episode_row(index: int, task: str, length: int, start: int, *, position: tuple[int, int],
+                video_start: int, chunks_size: int, fps: int, cameras: list[str],
+                stats: dict[str, dict[str, np.ndarray]], extras: dict[str, Any] | None) -> dict[str, Any]:
+    """The ``meta/episodes`` row of episode ``index``, whose frames start at dataset index ``start``.
+
+    vcage keeps an episode's data and videos at the same ``position`` (chunk, file); in each video
+    file the episode follows ``video_start`` frames of the episodes before it. ``stats`` are its
+    per-episode statistics.
+    """
+    chunk, file = position
     row: dict[str, Any] = {
         "episode_index": index, "tasks": [task], "length": length,
         "data/chunk_index": chunk, "data/file_index": file,
         "dataset_from_index": start, "dataset_to_index": start + length}
     for key in cameras:
         row |= {f"videos/{key}/chunk_index": chunk, f"videos/{key}/file_index": file,
-                f"videos/{key}/from_timestamp": 0.0, f"videos/{key}/to_timestamp": length / fps}
-    row |= {"meta/episodes/chunk_index": chunk, "meta/episodes/file_index": 0}
+                f"videos/{key}/from_timestamp": video_start / fps,
+                f"videos/{key}/to_timestamp": (video_start + length) / fps}
+    row |= {"meta/episodes/chunk_index": index // chunks_size, "meta/episodes/file_index": 0}
     row |= provenance(extras)
     row |= st.to_row(stats)
     return row

@@ -1,11 +1,17 @@
-"""LeRobot v3 dataset writer, atomic per episode.
+"""LeRobot v3 dataset writer, atomic per episode, packing episodes into shared files as LeRobot does.
 
-Each episode gets its own data parquet and one mp4 per camera (chunk = index // chunks_size,
-file = index % chunks_size). Files are written to a temporary name and moved into place; the meta
-files follow (with the dataset card ``README.md``), and rewriting ``meta/info.json`` last commits the
-episode. A failed episode is rolled back; leftovers of a crash beyond the commit point are removed
-when a writer reopens the dataset. Nothing is written before the first episode commits, and a writer
-refuses to append to a dataset whose files fail the cheap checks of :func:`vcage.data.verify.check`.
+An episode joins the open data parquet and each camera's open mp4 (the file is rewritten with the
+episode appended: parquet rows concatenated, video packets copied without re-encoding) unless that
+would take one of them past ``data_files_size_in_mb`` / ``video_files_size_in_mb``; then it starts
+the next file of each. Every file is written to a temporary name and moved into place; before a
+file holding committed episodes is replaced, its bytes are kept under a backup name
+(:func:`vcage.data.files.keep_backup`). The meta files follow (with the dataset card
+``README.md``), and rewriting ``meta/info.json`` last commits the episode; then the backups go. A
+failed episode is rolled back (backups restored, new files removed); a crash's leftovers are
+resolved when a writer reopens the dataset (:func:`vcage.data.files.settle_backups` puts back the
+committed bytes, files beyond the commit point are removed). Nothing is written before the first
+episode commits, and a writer refuses to append to a dataset whose files fail the cheap checks of
+:func:`vcage.data.verify.check`.
 """
 
 from __future__ import annotations
@@ -27,20 +33,25 @@ from vcage.data import layout, video
 from vcage.data import stats as st
 from vcage.data.card import dataset_card
 from vcage.data.files import (
+    BACKUP_MARK,
     TMP_MARK,
     atomic_write,
     diff,
     episode_row,
     episodes_table,
+    keep_backup,
     lock_dir,
     remove_empty_dirs,
+    restore_backup,
+    scratch,
+    settle_backups,
     tasks_table,
     to_json,
     write_json,
     write_table,
     write_text,
 )
-from vcage.data.reader import DTYPES, STANDARD_COLUMNS, DatasetReader, Feature, load_json
+from vcage.data.reader import DTYPES, STANDARD_COLUMNS, DatasetReader, Feature, load_json, read_parquet
 from vcage.data.verify import check
 from vcage.errors import CorruptDatasetError, DatasetError
 
@@ -52,17 +63,28 @@ class DatasetWriter:
     the end of a ``with`` block). A new dataset is written by its first :meth:`add_episode`: until
     then the directory stays empty, and a writer closed without an episode removes the directory
     (and its parents) if it created them.
+
+    ``data_files_size_in_mb`` and ``video_files_size_in_mb`` bound the shared files of a new
+    dataset (LeRobot's defaults; a single episode larger than the bound gets a file of its own); an
+    existing dataset keeps the bounds its ``meta/info.json`` records.
     """
 
     def __init__(self, root: str | Path, *, fps: int, features: Mapping[str, Feature],
                  cameras: Mapping[str, tuple[int, int]] | None = None, robot_type: str = "unknown",
-                 config: Mapping[str, Any] | None = None, chunks_size: int = layout.CHUNKS_SIZE) -> None:
+                 config: Mapping[str, Any] | None = None, chunks_size: int = layout.CHUNKS_SIZE,
+                 data_files_size_in_mb: float = layout.DATA_FILES_SIZE_IN_MB,
+                 video_files_size_in_mb: float = layout.VIDEO_FILES_SIZE_IN_MB) -> None:
         self.root = Path(root)
         if isinstance(fps, bool) or not isinstance(fps, int) or fps <= 0:
             raise DatasetError(f"fps must be a positive integer, got {fps!r}")
         if chunks_size < 1:
             raise DatasetError(f"chunks_size must be >= 1, got {chunks_size}")
+        for name, size in (("data_files_size_in_mb", data_files_size_in_mb),
+                           ("video_files_size_in_mb", video_files_size_in_mb)):
+            if isinstance(size, bool) or not isinstance(size, int | float) or not 0 < size < float("inf"):
+                raise DatasetError(f"{name} must be a positive number of megabytes, got {size!r}")
         self.fps, self.robot_type, self.chunks_size = fps, robot_type, chunks_size
+        self.file_mb = {"data": float(data_files_size_in_mb), "video": float(video_files_size_in_mb)}
         self.features = dict(features)
         self.cameras = {key: (int(h), int(w)) for key, (h, w) in (cameras or {}).items()}
         self.config: dict[str, Any] = to_json(dict(config or {}), "config")
@@ -73,6 +95,8 @@ class DatasetWriter:
         self._chunk_rows: list[dict[str, Any]] = []  # episode rows of the current episodes chunk file
         self._stats: dict[str, dict[str, np.ndarray]] = {}
         self._total_episodes = self._total_frames = 0
+        self._position: tuple[int, int] | None = None  # (chunk, file) of the last episode's files
+        self._file_frames = 0  # frames of the committed episodes in the files at _position
         self._lock_fd: int | None = None
         self._fresh = False  # the directory was absent or empty: the first episode creates the dataset
         self._made_dirs: list[Path] = []  # the directory and parents this writer created
@@ -161,6 +185,8 @@ class DatasetWriter:
         if not (self.root / layout.VCAGE_PATH).is_file() or not (self.root / layout.INFO_PATH).is_file():
             raise DatasetError(f"{self.root} is not empty and holds no vcage dataset (no {layout.VCAGE_PATH} "
                                f"and {layout.INFO_PATH}); choose another --out directory or an empty one")
+        with contextlib.suppress(Exception):  # a damaged info.json is the check's to report
+            settle_backups(self.root, int(load_json(self.root / layout.INFO_PATH)["total_episodes"]))
         report = check(self.root)
         if not report.ok:
             raise CorruptDatasetError(f"refusing to append to the damaged dataset {self.root}: "
@@ -181,6 +207,9 @@ class DatasetWriter:
                                f"({shown}); choose another --out directory, or pass the same config to "
                                "append to it")
         self._encoder = self._encoder_for(info)
+        for kind in self.file_mb:
+            with contextlib.suppress(TypeError, ValueError):
+                self.file_mb[kind] = float(info.get(f"{kind}_files_size_in_mb", self.file_mb[kind]))
         (self.root / layout.LEGACY_LOCK_PATH).unlink(missing_ok=True)  # older writers left it
         reader = DatasetReader(self.root)
         self._tasks = list(reader.tasks)
@@ -190,7 +219,20 @@ class DatasetWriter:
             self._stats = st.merge(self._stats, st.from_row(row))
         last_chunk = (self._total_episodes - 1) // self.chunks_size
         self._chunk_rows = [r for r in rows if r["episode_index"] // self.chunks_size == last_chunk]
+        if rows:
+            self._resume_position(rows)
         self._remove_leftovers(rewrite_meta=reader._uncommitted)
+
+    def _resume_position(self, rows: list[dict[str, Any]]) -> None:
+        """The open files' position and the frames they hold, from the committed rows."""
+        last = rows[-1]
+        self._position = layout.row_position(last, "data")
+        for key in self.cameras:
+            if layout.row_position(last, key) != self._position:
+                raise DatasetError(f"{self.root}: the last episode's {key} video is not at the position of "
+                                   "its data file, as vcage writes them; append with the tool that made it")
+        self._file_frames = sum(int(r["length"]) for r in rows
+                                if layout.row_position(r, "data") == self._position)
 
     def _uncommitted_first_episode(self) -> bool:
         """Whether the directory holds only what a writer killed during its first episode leaves:
@@ -206,7 +248,8 @@ class DatasetWriter:
         if (self.root / layout.VCAGE_PATH).is_file():  # a README.md is the card only beside our marker
             ours.append(layout.CARD_PATH)
         return ((path.name.startswith(".") and TMP_MARK in path.name)
-                or layout.episode_of_file(rel, self.chunks_size) is not None or rel in ours)
+                or layout.file_position(rel) is not None or layout.extras_episode(rel) is not None
+                or rel in ours)
 
     def _clear_uncommitted(self) -> None:
         """Remove what a killed first episode left, so the run starts the dataset again."""
@@ -226,13 +269,16 @@ class DatasetWriter:
                            "encode it; append with the environment that created the dataset")
 
     def _remove_leftovers(self, rewrite_meta: bool) -> None:
-        """Delete temporary files and episode files beyond the commit point (a crash's leftovers)."""
+        """Delete temporary files, backups, and episode files beyond the commit point (a crash's
+        leftovers; the backups were settled before the dataset was checked)."""
         for path in sorted(self.root.rglob("*")):
             if not path.is_file():
                 continue
-            index = layout.episode_of_file(path.relative_to(self.root).as_posix(), self.chunks_size)
-            temporary = path.name.startswith(".") and TMP_MARK in path.name
-            if temporary or (index is not None and index >= self._total_episodes):
+            rel = path.relative_to(self.root).as_posix()
+            found, index = layout.file_position(rel), layout.extras_episode(rel)
+            hidden = path.name.startswith(".") and (TMP_MARK in path.name or BACKUP_MARK in path.name)
+            beyond = found is not None and (self._position is None or found[1] > self._position)
+            if hidden or beyond or (index is not None and index >= self._total_episodes):
                 path.unlink()
         if self._total_episodes == 0:
             for path in [self.root / layout.TASKS_PATH, self.root / layout.STATS_PATH,
@@ -260,7 +306,8 @@ class DatasetWriter:
         info = {"codebase_version": layout.CODEBASE_VERSION, "robot_type": self.robot_type,
                 "total_episodes": episodes, "total_frames": frames, "total_tasks": tasks,
                 "chunks_size": self.chunks_size,
-                "data_files_size_in_mb": 100, "video_files_size_in_mb": 200, "fps": self.fps,
+                "data_files_size_in_mb": _number(self.file_mb["data"]),
+                "video_files_size_in_mb": _number(self.file_mb["video"]), "fps": self.fps,
                 "splits": {"train": f"0:{episodes}"}, "data_path": layout.DATA_PATH,
                 "video_path": layout.VIDEO_PATH if self.cameras else None, "features": features}
         return info
@@ -353,23 +400,22 @@ class DatasetWriter:
         if any(a.dtype == object for a in states.values()):
             raise DatasetError("arrays must be numeric numpy arrays (object arrays cannot be stored)")
         index, length = self._total_episodes, len(next(iter(checked.values())))
-        chunk, file = divmod(index, self.chunks_size)
         tasks = self._tasks if task in self._tasks else [*self._tasks, task]
         table = self._data_table(checked, index, tasks.index(task), length)
         episode_stats = self._episode_stats(table, checked)
-        row = episode_row(index, task, length, self._total_frames, chunks_size=self.chunks_size, fps=self.fps,
-                          cameras=list(self.cameras), stats=episode_stats, extras=extras_json)
-        chunk_rows = [*(self._chunk_rows if file else []), row]
+        chunk_rows = self._chunk_rows if index % self.chunks_size else []
         stats = st.merge(self._stats, episode_stats)
-        written: list[Path] = []
+        files = _EpisodeFiles()
         meta_touched = False
-
-        def commit() -> None:
-            self._tasks, self._chunk_rows, self._stats = tasks, chunk_rows, stats
-            self._total_episodes, self._total_frames = index + 1, self._total_frames + length
-
+        position, video_start = (0, 0), 0
         try:
-            self._write_files(index, table, checked, extras_json if extras else None, states, written)
+            position, joined = self._write_files(index, table, checked, extras_json if extras else None,
+                                                 states, files)
+            video_start = self._file_frames if joined else 0
+            row = episode_row(index, task, length, self._total_frames, position=position,
+                              video_start=video_start, chunks_size=self.chunks_size, fps=self.fps,
+                              cameras=list(self.cameras), stats=episode_stats, extras=extras_json)
+            chunk_rows = [*chunk_rows, row]
             meta_touched = True
             if self._fresh and index == 0:
                 self._write_marker()
@@ -379,49 +425,95 @@ class DatasetWriter:
             self._write_info(index + 1, frames_after, len(tasks))
         except BaseException:
             if self._committed(index + 1):  # interrupted after the commit point: the episode is in
-                commit()
+                self._tasks, self._chunk_rows, self._stats = tasks, chunk_rows, stats
+                self._advance(position, video_start + length, length)
+                files.forget_backups()
             else:
-                self._rollback(written, meta_touched, index)
+                self._rollback(files, meta_touched, index)
             raise
-        commit()
+        self._tasks, self._chunk_rows, self._stats = tasks, chunk_rows, stats
+        self._advance(position, video_start + length, length)
+        files.forget_backups()
         return index
 
+    def _advance(self, position: tuple[int, int], file_frames: int, length: int) -> None:
+        self._position, self._file_frames = position, file_frames
+        self._total_episodes, self._total_frames = self._total_episodes + 1, self._total_frames + length
+
+    def _joins(self, sizes: dict[str, int]) -> bool:
+        """Whether an episode whose own files take ``sizes`` bytes (by data/camera key) joins the open
+        files, or starts the next ones because one would grow past its size limit."""
+        if self._position is None:
+            return False
+        for key, size in sizes.items():
+            path = self._file(key, self._position)
+            limit = self.file_mb["data" if key == "data" else "video"] * 1024 * 1024
+            if not path.is_file() or path.stat().st_size + size > limit:
+                return False
+        return True
+
+    def _file(self, key: str, position: tuple[int, int]) -> Path:
+        chunk, file = position
+        if key == "data":
+            return self.root / layout.DATA_PATH.format(chunk_index=chunk, file_index=file)
+        return self.root / layout.VIDEO_PATH.format(video_key=key, chunk_index=chunk, file_index=file)
+
     def _write_files(self, index: int, table: pa.Table, checked: dict[str, np.ndarray], extras: Any,
-                     states: dict[str, np.ndarray], written: list[Path]) -> None:
-        """Data parquet, one mp4 per camera, extras json and arrays npz; ``written`` lists them."""
-        chunk, file = divmod(index, self.chunks_size)
-
-        def put(path: Path, write: Callable[[Path], object]) -> None:
-            written.append(path)
-            atomic_write(path, write)
-
-        put(self.root / layout.DATA_PATH.format(chunk_index=chunk, file_index=file),
-            lambda tmp: pq.write_table(table, tmp))
-        for key in self.cameras:
-            path = self.root / layout.VIDEO_PATH.format(video_key=key, chunk_index=chunk, file_index=file)
-            put(path, functools.partial(video.encode_video, frames=checked[key], fps=self.fps,
-                                        encoder=self._encoder))
+                     states: dict[str, np.ndarray], files: _EpisodeFiles) -> tuple[tuple[int, int], bool]:
+        """Data rows, one video per camera (joined to the open files or starting the next), extras
+        json and arrays npz; ``files`` records what was created or replaced. Returns the position
+        of the episode's data and video files and whether it joined the open ones."""
+        buffer = pa.BufferOutputStream()
+        pq.write_table(table, buffer)
+        data = buffer.getvalue()
+        encoded: dict[str, Path] = {}
+        for key in self.cameras:  # encode first: the sizes decide whether the episode joins the open files
+            scratch_dir = self.root / "videos" / key
+            scratch_dir.mkdir(parents=True, exist_ok=True)
+            tmp = files.scratch(scratch(scratch_dir / "episode.mp4"))
+            video.encode_video(tmp, checked[key], fps=self.fps, encoder=self._encoder)
+            encoded[key] = tmp
+        joined = self._joins({"data": data.size, **{k: p.stat().st_size for k, p in encoded.items()}})
+        assert self._position is not None or not joined
+        position = self._position if joined and self._position is not None else (
+            layout.next_position(self._position, self.chunks_size) if self._position is not None else (0, 0))
+        committed = self._total_episodes
+        path = self._file("data", position)
+        if joined:
+            files.replace(path, committed, lambda tmp: pq.write_table(
+                pa.concat_tables([read_parquet(path), table]), tmp))
+        else:
+            files.create(path, lambda tmp: tmp.write_bytes(data.to_pybytes()))
+        for key, tmp_video in encoded.items():
+            path = self._file(key, position)
+            if joined:
+                sources = [(path, self._file_frames), (tmp_video, len(checked[key]))]
+                files.replace(path, committed, functools.partial(video.concat_videos, sources, fps=self.fps))
+            else:
+                files.create(path, functools.partial(os.replace, tmp_video))
         if extras is not None:
             text = json.dumps(extras, indent=1)
-            put(self.root / layout.EXTRAS_PATH.format(episode_index=index), lambda tmp: tmp.write_text(text))
+            files.create(self.root / layout.EXTRAS_PATH.format(episode_index=index),
+                         lambda tmp: tmp.write_text(text))
         if states:
             def save(tmp: Path) -> None:
-                buffer = io.BytesIO()
-                cast(Any, np.savez_compressed)(buffer, **states)
-                tmp.write_bytes(buffer.getvalue())
+                out = io.BytesIO()
+                cast(Any, np.savez_compressed)(out, **states)
+                tmp.write_bytes(out.getvalue())
 
-            put(self.root / layout.ARRAYS_PATH.format(episode_index=index), save)
+            files.create(self.root / layout.ARRAYS_PATH.format(episode_index=index), save)
+        files.remove_scratch()
+        return position, joined
 
     def _committed(self, episodes: int) -> bool:
         with contextlib.suppress(Exception):
             return int(load_json(self.root / layout.INFO_PATH)["total_episodes"]) >= episodes
         return False
 
-    def _rollback(self, written: list[Path], meta_touched: bool, index: int) -> None:
-        """Undo a failed episode: remove its files and restore the meta files (best effort)."""
-        for path in written:
-            with contextlib.suppress(OSError):
-                path.unlink(missing_ok=True)
+    def _rollback(self, files: _EpisodeFiles, meta_touched: bool, index: int) -> None:
+        """Undo a failed episode: put back the files it replaced, remove those it created, restore the
+        meta files (best effort)."""
+        files.undo()
         if not meta_touched:
             return
         with contextlib.suppress(Exception):
@@ -439,3 +531,50 @@ class DatasetWriter:
                 chunk = index // self.chunks_size
                 episodes = self.root / layout.EPISODES_PATH.format(chunk_index=chunk, file_index=0)
                 episodes.unlink(missing_ok=True)
+
+
+class _EpisodeFiles:
+    """The files one episode's write created, replaced (with their backups) and used as scratch."""
+
+    def __init__(self) -> None:
+        self.created: list[Path] = []
+        self.backups: list[tuple[Path, Path]] = []  # (file, its bytes before the episode)
+        self.scratches: list[Path] = []
+
+    def scratch(self, path: Path) -> Path:
+        self.scratches.append(path)
+        return path
+
+    def create(self, path: Path, write: Callable[[Path], object]) -> None:
+        self.created.append(path)
+        atomic_write(path, write)
+
+    def replace(self, path: Path, committed: int, write: Callable[[Path], object]) -> None:
+        """Rewrite ``path`` (which holds ``committed`` episodes' content) after keeping a backup."""
+        self.backups.append((path, keep_backup(path, committed)))
+        atomic_write(path, write)
+
+    def remove_scratch(self) -> None:
+        for path in self.scratches:
+            path.unlink(missing_ok=True)
+
+    def forget_backups(self) -> None:
+        """The episode committed: the backups are no longer needed."""
+        for _, backup in self.backups:
+            with contextlib.suppress(OSError):
+                backup.unlink(missing_ok=True)
+
+    def undo(self) -> None:
+        """The episode did not commit: back to the files as they were (best effort)."""
+        self.remove_scratch()
+        for path in self.created:
+            with contextlib.suppress(OSError):
+                path.unlink(missing_ok=True)
+        for path, backup in self.backups:
+            with contextlib.suppress(OSError):
+                restore_backup(backup, path)
+
+
+def _number(value: float) -> int | float:
+    """A size for ``meta/info.json``: an integer when it is one (as LeRobot writes its defaults)."""
+    return int(value) if float(value).is_integer() else value

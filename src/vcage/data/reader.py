@@ -26,7 +26,7 @@ from vcage.data.layout import (
     TASKS_PATH,
     VCAGE_PATH,
 )
-from vcage.data.video import decode_video
+from vcage.data.video import decode_window
 from vcage.errors import CorruptDatasetError, DatasetError
 
 DTYPES = {"float32": pa.float32(), "float64": pa.float64(), "int32": pa.int32(), "int64": pa.int64(),
@@ -270,11 +270,9 @@ class DatasetReader:
         """Decoded frames (T, H, W, 3) uint8 of one camera for one episode."""
         path = self.video_path(index, key)
         row = self.episode_meta(index)
-        frames, times = decode_video(path)
-        half = 0.5 / self.fps
         start, stop = float(row[f"videos/{key}/from_timestamp"]), float(row[f"videos/{key}/to_timestamp"])
-        keep = (times >= start - half) & (times < stop - half)
-        if int(keep.sum()) != row["length"]:
-            raise CorruptDatasetError(f"{path} holds {int(keep.sum())} frames for episode {index}, "
-                               f"expected {row['length']}; the dataset is corrupt")
-        return frames[keep]
+        frames = decode_window(path, start, stop, self.fps)  # seeks: a shared file is not decoded whole
+        if len(frames) != row["length"]:
+            raise CorruptDatasetError(f"{path} holds {len(frames)} frames for episode {index}, "
+                                      f"expected {row['length']}; the dataset is corrupt")
+        return frames

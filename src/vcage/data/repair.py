@@ -9,21 +9,27 @@ why, and how many healthy episodes the cut cost.
 from __future__ import annotations
 
 import contextlib
+import functools
 import os
 from collections import defaultdict
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+import pyarrow.compute as pc
+
 from vcage.data import layout, video
 from vcage.data import stats as st
 from vcage.data.card import dataset_card
 from vcage.data.files import (
+    BACKUP_MARK,
     TMP_MARK,
+    atomic_write,
     episode_row,
     episodes_table,
     lock_dir,
     remove_empty_dirs,
+    settle_backups,
     tasks_table,
     write_json,
     write_table,
@@ -79,10 +85,13 @@ def repair(root: str | Path) -> RepairReport:
 
     Holds the writer's lock meanwhile (DatasetError if a writer is appending). Runs :func:`verify`
     (so it costs a decode of every video, twice: before and after). The episodes before the first
-    damaged one are kept byte for byte; ``meta/info.json`` is rewritten first (the commit point now
-    counts only the kept episodes), then ``stats.json``, ``tasks.parquet``, the episodes files and
-    the card, then the dropped episodes' files are deleted, so a crash midway leaves a dataset that
-    reads as the kept episodes plus leftovers the next writer removes. Damaged metadata alone
+    damaged one are kept: their files byte for byte, except a data or video file they share with
+    dropped episodes, which is cut after the last kept episode (rows filtered, video packets copied
+    without re-encoding) before anything else, so a crash there leaves the dropped episodes damaged
+    and the kept ones intact. Then ``meta/info.json`` is rewritten (the commit point now counts only
+    the kept episodes), then ``stats.json``, ``tasks.parquet``, the episodes files and the card,
+    then the dropped episodes' files are deleted, so a crash midway leaves a dataset that reads as
+    the kept episodes plus leftovers the next writer removes. Damaged metadata alone
     (``stats.json``, ``tasks.parquet``, the totals in ``info.json``, or ``info.json`` itself when
     ``meta/vcage.json`` keeps a copy of its layout) is rebuilt from the episode rows.
 
@@ -95,6 +104,8 @@ def repair(root: str | Path) -> RepairReport:
         raise DatasetError(f"{root} is not a directory; give a dataset directory")
     fd = lock_dir(root)
     try:
+        with contextlib.suppress(Exception):  # an interrupted write's replaced files: the committed bytes
+            settle_backups(root, int(load_json(root / layout.INFO_PATH)["total_episodes"]))
         scan = Scan(root, decode=True).run()
         before = scan.report()
         if before.ok:
@@ -128,8 +139,10 @@ def _rewrite(scan: Scan, before: VerifyReport, found: VerifyReport, kept: int,
     frames = sum(int(r["length"]) for r in rows)
     info = {**static, "total_episodes": kept, "total_frames": frames, "total_tasks": len(tasks),
             "splits": {"train": f"0:{kept}"}}
-    rewritten = [layout.INFO_PATH]
-    write_json(root / layout.INFO_PATH, info)  # the commit point first: nothing beyond is read now
+    keep = _files_of(scan, range(kept))
+    doomed = _files_of(scan, range(kept, scan.episodes))
+    rewritten = [*_cut_shared(scan, kept, sorted(keep & doomed)), layout.INFO_PATH]
+    write_json(root / layout.INFO_PATH, info)  # the commit point: nothing beyond is read now
     stats: dict[str, st.Stats] = {}
     for row in rows:
         stats = st.merge(stats, st.from_row(row))
@@ -152,21 +165,20 @@ def _rewrite(scan: Scan, before: VerifyReport, found: VerifyReport, kept: int,
     if scan.marker is not None:  # a vcage dataset: its card is vcage's (never replace another's README)
         write_text(root / layout.CARD_PATH, dataset_card(info, tasks))
         rewritten.append(layout.CARD_PATH)
-    keep = _files_of(scan, range(kept))
     for path in sorted((root / "meta" / "episodes").glob("chunk-*/file-*.parquet")):
         rel = path.relative_to(root).as_posix()
         if rel not in by_file:
             path.unlink()
             removed.append(rel)
-    chunks_size = int(static.get("chunks_size") or layout.CHUNKS_SIZE)
-    doomed = _files_of(scan, range(kept, scan.episodes))
+    last = rows[-1] if rows else None
     for path in sorted(root.rglob("*")):
         if not path.is_file():
             continue
         rel = path.relative_to(root).as_posix()
-        index = layout.episode_of_file(rel, chunks_size)
-        stale = (index is not None and index >= kept) or rel in doomed or (
-            path.name.startswith(".") and TMP_MARK in path.name)
+        index, position = layout.extras_episode(rel), layout.file_position(rel)
+        hidden = path.name.startswith(".") and (TMP_MARK in path.name or BACKUP_MARK in path.name)
+        stale = (index is not None and index >= kept) or rel in doomed or hidden or (
+            position is not None and _beyond(position, last))
         if stale and rel not in keep:
             path.unlink()
             removed.append(rel)
@@ -185,13 +197,49 @@ def _rewrite(scan: Scan, before: VerifyReport, found: VerifyReport, kept: int,
                         {i: reasons[i] for i in dropped if i in damaged}, rebuilt)
 
 
+def _beyond(found: tuple[str, tuple[int, int]], last: dict[str, Any] | None) -> bool:
+    """Whether a data or video file lies after the files of the last kept episode's row."""
+    if last is None:
+        return True
+    key, position = found
+    try:
+        return position > layout.row_position(last, key)
+    except (KeyError, ValueError, TypeError):
+        return False  # a camera the rows do not know: not vcage's to delete
+
+
+def _cut_shared(scan: Scan, kept: int, shared: list[str]) -> list[str]:
+    """Cut the data and video files that hold kept and dropped episodes after the last kept one."""
+    static = scan.static
+    assert static is not None
+    fps = int(static["fps"])
+    cameras = [k for k, f in static["features"].items() if f.get("dtype") == "video"]
+    out = []
+    for rel in shared:
+        found = layout.file_position(rel)
+        if found is None:
+            continue
+        key, position = found
+        path = scan.root / rel
+        if key == "data":
+            table = read_parquet(path)
+            table = table.filter(pc.less(table.column("episode_index"), kept))
+            write_table(path, table)
+        elif key in cameras:
+            frames = sum(int(scan.rows[i]["length"]) for i in range(kept)
+                         if layout.row_position(scan.rows[i], key) == position)
+            atomic_write(path, functools.partial(video.concat_videos, [(path, frames)], fps=fps))
+        out.append(rel)
+    return out
+
+
 def _rebuild_rows(scan: Scan) -> dict[int, dict[str, Any]]:
     """Rows for committed episodes whose ``meta/episodes`` row is lost, rebuilt from their files.
 
-    Only for vcage datasets (one episode per file, tasks and ``info.json`` readable), in episode
-    order, up to the first episode whose files do not allow it (that one is damaged). Vector
-    statistics come out exact; image statistics are taken from the decoded video, not the frames
-    the writer saw, so they differ slightly from the lost ones.
+    Only for vcage datasets (data and videos at the same position, tasks and ``info.json``
+    readable), in episode order, up to the first episode whose files do not allow it (that one is
+    damaged). Vector statistics come out exact; image statistics are taken from the decoded video,
+    not the frames the writer saw, so they differ slightly from the lost ones.
     """
     static, tasks = scan.static, scan.tasks
     missing = [i for i in range(scan.episodes) if i not in scan.rows]
@@ -202,21 +250,29 @@ def _rebuild_rows(scan: Scan) -> dict[int, dict[str, Any]]:
         before = scan.rows.get(i - 1) or out.get(i - 1)
         if i and before is None:
             break
-        start = int(before["dataset_to_index"]) if before is not None else 0
         try:
-            out[i] = _rebuild_row(scan.root, static, tasks, i, start)
+            out[i] = _rebuild_row(scan.root, static, tasks, i, before)
         except (DatasetError, KeyError, ValueError, TypeError, *NPZ_ERRORS):
             break
     return out
 
 
 def _rebuild_row(root: Path, static: dict[str, Any], tasks: list[str], index: int,
-                 start: int) -> dict[str, Any]:
+                 before: dict[str, Any] | None) -> dict[str, Any]:
+    """The row of episode ``index``, found in the data file of the episode ``before`` it or the next."""
     chunks_size, fps = int(static.get("chunks_size") or layout.CHUNKS_SIZE), int(static["fps"])
-    chunk, file = divmod(index, chunks_size)
-    table = read_parquet(root / static["data_path"].format(chunk_index=chunk, file_index=file))
-    if set(table.column("episode_index").to_pylist()) != {index}:
-        raise CorruptDatasetError(f"the data file of episode {index} holds other episodes")
+    first = layout.row_position(before, "data") if before is not None else (0, 0)
+    for position in (first, layout.next_position(first, chunks_size)):
+        path = root / static["data_path"].format(chunk_index=position[0], file_index=position[1])
+        if path.is_file():
+            full = read_parquet(path)
+            episodes = full.column("episode_index").to_numpy()
+            if (episodes == index).any():
+                break
+    else:
+        raise CorruptDatasetError(f"no data file holds episode {index}")
+    table = full.filter(pc.equal(full.column("episode_index"), index))
+    video_start = int((episodes < index).sum())  # frames of the episodes before it in the same files
     (task_index,) = set(table.column("task_index").to_pylist())
     length = table.num_rows
     cameras = [k for k, f in static["features"].items() if f.get("dtype") == "video"]
@@ -225,8 +281,10 @@ def _rebuild_row(root: Path, static: dict[str, Any], tasks: list[str], index: in
         if feature.get("dtype") != "video" and key not in STANDARD_COLUMNS:
             stats[key] = st.vector_stats(column_to_numpy(table.column(key)).reshape(length, -1))
     for key in cameras:
-        frames, _ = video.decode_video(root / static["video_path"].format(video_key=key, chunk_index=chunk,
-                                                                          file_index=file))
+        chunk, file = position
+        frames = video.decode_window(
+            root / static["video_path"].format(video_key=key, chunk_index=chunk, file_index=file),
+            video_start / fps, (video_start + length) / fps, fps)
         if len(frames) != length:
             raise CorruptDatasetError(f"the video {key} of episode {index} has {len(frames)} frames")
         stats[key] = st.image_stats(frames)
@@ -234,8 +292,10 @@ def _rebuild_row(root: Path, static: dict[str, Any], tasks: list[str], index: in
         stats[key] = st.vector_stats(table.column(key).to_numpy())
     extras_path = root / layout.EXTRAS_PATH.format(episode_index=index)
     extras = load_json(extras_path) if extras_path.exists() else None
-    return episode_row(index, tasks[task_index], length, start, chunks_size=chunks_size, fps=fps,
-                       cameras=cameras, stats=stats, extras=extras if isinstance(extras, dict) else None)
+    start = int(before["dataset_to_index"]) if before is not None else 0
+    return episode_row(index, tasks[task_index], length, start, position=position, video_start=video_start,
+                       chunks_size=chunks_size, fps=fps, cameras=cameras, stats=stats,
+                       extras=extras if isinstance(extras, dict) else None)
 
 
 def _kept_tasks(tasks: list[str] | None, rows: list[dict[str, Any]]) -> list[str]:

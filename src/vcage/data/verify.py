@@ -8,7 +8,9 @@ episode rows and the tasks). :func:`check` runs the cheap subset that ``vcage in
 audit``, the writer (before it appends) and the robomimic export run.
 
 Only committed episodes are checked: files and rows beyond ``meta/info.json``'s count are a crash's
-leftovers, which the writer removes when it reopens the dataset.
+leftovers, which the writer removes when it reopens the dataset. A shared data or video file that
+an interrupted episode had already replaced is checked in the backup holding its committed bytes
+(:func:`vcage.data.files.committed_version`), which the next writer or repair moves back.
 """
 
 from __future__ import annotations
@@ -24,6 +26,7 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 
 from vcage.data import layout, video
+from vcage.data.files import committed_version
 from vcage.data.reader import NPZ_ERRORS, STANDARD_COLUMNS, load_json, load_npz, read_parquet
 from vcage.errors import CorruptDatasetError, DatasetError
 
@@ -372,8 +375,9 @@ class Scan:
             if not path.is_file():
                 self._each(path, episodes, "missing")
                 continue
+            source = committed_version(path, self.episodes)
             try:
-                parquet = pq.ParquetFile(path)
+                parquet = pq.ParquetFile(source)
                 names = set(parquet.schema_arrow.names)
                 rows = parquet.metadata.num_rows
             except (OSError, ValueError, pa.ArrowException) as exc:
@@ -387,11 +391,11 @@ class Scan:
                 self._each(path, episodes, f"holds {rows} rows, the episodes need {sum(lengths.values())}")
                 continue
             if self.decode:
-                self._check_table(path, episodes)
+                self._check_table(path, source, episodes)
 
-    def _check_table(self, path: Path, episodes: list[int]) -> None:
+    def _check_table(self, path: Path, source: Path, episodes: list[int]) -> None:
         try:
-            table = pq.read_table(path)  # every column: a damaged page anywhere fails here
+            table = pq.read_table(source)  # every column: a damaged page anywhere fails here
             columns = {name: table.column(name).to_numpy() for name in STANDARD_COLUMNS}
         except (OSError, ValueError, KeyError, pa.ArrowException) as exc:
             self._each(path, episodes, f"not a readable parquet file: {_first_line(exc)}")
@@ -425,8 +429,9 @@ class Scan:
                 if not path.is_file():
                     self._each(path, episodes, "missing")
                     continue
+                source = committed_version(path, self.episodes)
                 try:
-                    probe = video.probe_video(path)
+                    probe = video.probe_video(source)
                 except CorruptDatasetError as exc:
                     self._each(path, episodes, _reason(exc))
                     continue
@@ -437,11 +442,11 @@ class Scan:
                     self._each(path, episodes, f"its container holds {probe.frames} frames, the episodes "
                                                f"need {expected}")
                 elif self.decode:
-                    self._check_decoded(path, episodes, key, fps)
+                    self._check_decoded(path, source, episodes, key, fps)
 
-    def _check_decoded(self, path: Path, episodes: list[int], key: str, fps: int) -> None:
+    def _check_decoded(self, path: Path, source: Path, episodes: list[int], key: str, fps: int) -> None:
         try:
-            times = video.decode_times(path)
+            times = video.decode_times(source)
         except CorruptDatasetError as exc:
             self._each(path, episodes, _reason(exc))
             return

@@ -18,13 +18,15 @@ PIX_FMT = "yuv420p"
 # Encoder preference and fast settings; g=2 keeps frames close to the source and makes seeking
 # cheap, as LeRobot does. H.264 comes first: SVT-AV1 (LeRobot's default) was seen to deadlock in
 # its thread pool during a long generation run on a 2-core machine, so it is only a fallback,
-# restricted to one thread. Small videos need no more than one encoder thread anyway.
+# restricted to one thread. Small videos need no more than one encoder thread anyway. No B-frames
+# (``bf=0``): every packet is shown when it is decoded, so episodes encoded one at a time can be
+# joined into one file by copying their packets (:func:`concat_videos`) with increasing timestamps.
 ENCODER_OPTIONS: dict[str, dict[str, str]] = {
-    "libx264": {"preset": "veryfast", "crf": "20", "g": "2", "threads": "1"},
-    "h264": {"preset": "veryfast", "crf": "20", "g": "2", "threads": "1"},
+    "libx264": {"preset": "veryfast", "crf": "20", "g": "2", "bf": "0", "threads": "1"},
+    "h264": {"preset": "veryfast", "crf": "20", "g": "2", "bf": "0", "threads": "1"},
     "libsvtav1": {"preset": "11", "crf": "30", "g": "2", "svtav1-params": "lp=1"},
     "libaom-av1": {"cpu-used": "8", "crf": "30", "g": "2", "threads": "1"},
-    "mpeg4": {"qmin": "2", "qmax": "4", "g": "2", "threads": "1"},
+    "mpeg4": {"qmin": "2", "qmax": "4", "g": "2", "bf": "0", "threads": "1"},
 }
 
 
@@ -182,3 +184,75 @@ def decode_times(path: Path) -> np.ndarray:
     except (av.FFmpegError, IndexError, OSError, ValueError) as exc:
         raise CorruptDatasetError(f"cannot decode video {path}: {exc}") from exc
     return np.asarray(times, dtype=np.float64)
+
+
+def concat_videos(sources: list[tuple[Path, int]], out: Path, fps: int) -> None:
+    """Write the first ``n`` frames of each ``(path, n)`` source, one after the other, to ``out``.
+
+    Stream copy (no re-encoding, so decoded frames stay bit-identical): packets are copied with
+    their timestamps shifted by the frames before them, so source k's frame i gets timestamp
+    ``(frames of the sources before k + i) / fps``. Each source must start with a key frame and
+    its frames must not reference frames beyond the cut (true of the episodes vcage encodes one at
+    a time); the sources must share codec, size and time base. CorruptDatasetError names a source
+    that cannot be read or has fewer than ``n`` frames; DatasetError one that does not match.
+    """
+    frame_seconds = Fraction(1, fps)
+    with av.open(str(out), "w", format="mp4") as container:
+        target: av.VideoStream | None = None
+        template: tuple[object, ...] | None = None
+        offset = Fraction(0)  # seconds before the current source
+        for path, keep in sources:
+            copied = 0
+            try:
+                with av.open(str(path)) as source:
+                    stream = source.streams.video[0]
+                    ctx = stream.codec_context
+                    shape = (ctx.name, ctx.width, ctx.height, stream.time_base, bytes(ctx.extradata or b""))
+                    if target is None:
+                        target, template = container.add_stream_from_template(stream), shape
+                    elif shape != template:
+                        raise DatasetError(f"cannot join {path} to the videos before it: codec, size, time "
+                                           "base or encoder settings differ")
+                    tb = stream.time_base
+                    assert tb is not None
+                    shift = int(offset / tb)
+                    cut = Fraction(keep) * frame_seconds - frame_seconds / 2  # frames before it are kept
+                    for packet in source.demux(stream):
+                        if packet.dts is None or packet.pts is None:
+                            continue  # the demuxer's empty flush packet
+                        if packet.pts * tb >= cut:
+                            continue
+                        packet.pts += shift
+                        packet.dts += shift
+                        packet.stream = target
+                        container.mux(packet)
+                        copied += 1
+            except (av.FFmpegError, IndexError, OSError, ValueError) as exc:
+                raise CorruptDatasetError(f"cannot read video {path}: {exc}") from exc
+            if copied != keep:
+                raise CorruptDatasetError(f"video {path} holds {copied} of the {keep} frames to copy")
+            offset += Fraction(keep) * frame_seconds
+
+
+def decode_window(path: Path, start: float, stop: float, fps: int) -> np.ndarray:
+    """Decode the frames of an MP4 with timestamps in ``[start, stop)`` (half a frame of tolerance),
+    seeking to the key frame before ``start`` rather than decoding the file from its beginning."""
+    half = 0.5 / fps
+    frames: list[np.ndarray] = []
+    try:
+        with av.open(str(path)) as container:
+            stream = container.streams.video[0]
+            tb = stream.time_base
+            if start > half and tb is not None:
+                container.seek(int((start - half) / tb), stream=stream, backward=True, any_frame=False)
+            for frame in container.decode(stream):
+                time = float(frame.time) if frame.time is not None else float("nan")
+                if time >= stop - half:
+                    break
+                if time >= start - half:
+                    frames.append(frame.to_ndarray(format="rgb24"))
+    except (av.FFmpegError, IndexError, OSError, ValueError) as exc:
+        raise CorruptDatasetError(f"cannot decode video {path}: {exc}") from exc
+    if not frames:
+        raise CorruptDatasetError(f"video {path} holds no frames between {start:.3f} s and {stop:.3f} s")
+    return np.stack(frames)
