@@ -12,6 +12,9 @@ precision and recall of "accept" (as in ``vcage audit``), and the share of the o
 critic rejected (what keeps them out of a dataset).
 
     LP_NUM_THREADS=1 .venv/bin/python benchmarks/critic_agreement.py --seeds 10 --workers 2
+
+``--mesh-detail full`` renders the critic's views with the robot's meshes as shipped (the default
+is the simplified meshes, as in a run).
 """
 
 from __future__ import annotations
@@ -23,6 +26,7 @@ from concurrent.futures import ProcessPoolExecutor
 
 os.environ.setdefault("LP_NUM_THREADS", "1")  # one rasteriser thread: a worker is one core
 
+from vcage.config import MESH_DETAILS, RenderConfig  # noqa: E402
 from vcage.critics import Critic, CriticConfig, Observation, Verdict, make_critic  # noqa: E402
 from vcage.pipeline.config import GenerateConfig  # noqa: E402
 from vcage.pipeline.episode import attempt  # noqa: E402
@@ -45,11 +49,12 @@ class Shadow(Critic):
         return Verdict(True, "shadow: the rollout continues")
 
 
-def _run(job: tuple[str, int]) -> list[tuple[str, bool, bool]]:
-    goal, episode = job
+def _run(job: tuple[str, int, str]) -> list[tuple[str, bool, bool]]:
+    goal, episode, mesh_detail = job
     phrase = next(g for g in GOALS if g.name == goal).phrasings[0]
     plan = make_planner("offline").plan(phrase)
-    cfg = GenerateConfig.vanilla(seed=0)  # episode k: the seed of the Vanilla run's episode k
+    # episode k: the seed of the Vanilla run's episode k
+    cfg = GenerateConfig.vanilla(seed=0, render=RenderConfig(mesh_detail=mesh_detail))
     shadow = Shadow(make_critic(CriticConfig("image")))
     result = attempt(plan, cfg.episode_seed(episode, 0), cfg, shadow)
     if result.rollout is None:
@@ -74,13 +79,16 @@ def main() -> None:
     parser.add_argument("--seeds", type=int, default=10, help="Vanilla rollouts per goal (episodes 0..N-1)")
     parser.add_argument("--goals", nargs="*", default=list(DEFAULT_GOALS))
     parser.add_argument("--workers", type=int, default=2)
+    parser.add_argument("--mesh-detail", choices=MESH_DETAILS, default=RenderConfig().mesh_detail,
+                        help="how the critic's views draw the robot's meshes")
     args = parser.parse_args()
-    jobs = [(g, s) for g in args.goals for s in range(args.seeds)]
+    jobs = [(g, s, args.mesh_detail) for g in args.goals for s in range(args.seeds)]
     t0 = time.perf_counter()
     with ProcessPoolExecutor(args.workers) as pool:
         pairs = [p for rows in pool.map(_run, jobs) for p in rows]
     print(f"image critic vs oracle on Vanilla rollouts (naive placement, no scene check), "
-          f"{args.seeds} seeds per goal, every subtask judged; {time.perf_counter() - t0:.0f} s wall\n")
+          f"{args.seeds} seeds per goal, every subtask judged, mesh detail {args.mesh_detail}; "
+          f"{time.perf_counter() - t0:.0f} s wall\n")
     print(f"{'goal':24s} {'judged':>6s} {'failures':>8s} {'agree':>7s} {'prec':>7s} {'recall':>7s} "
           f"{'caught':>9s}")
     for goal in args.goals:

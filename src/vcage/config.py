@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import math
+import os
 from dataclasses import asdict, dataclass, field, fields, replace
+from pathlib import Path
 from typing import Any, TypeVar
 
 from vcage.errors import ConfigError
@@ -14,6 +16,9 @@ C = TypeVar("C")
 # (width, height); `vcage.scene.compose` builds them and a test holds it to these names.
 CAMERAS = ("front", "overview", "top", "panda/wrist")
 OFFSCREEN_SIZE = (640, 480)
+# How the renderer draws heavy visual meshes (the robot's): as shipped, or simplified once
+# (`vcage.sim.lod`): a twelfth of the faces, the same outlines (`benchmarks/render_lod.py`).
+MESH_DETAILS = ("full", "lod")
 
 
 def from_fields(cls: type[C], data: Any, **nested: Any) -> C:
@@ -161,12 +166,14 @@ class RenderConfig:
     """What is rendered: the cameras recorded as videos and their size, and the critic's views.
 
     Sizes are (width, height) and are checked against the renderer's offscreen buffer; video sizes
-    must be even (H.264 4:2:0).
+    must be even (H.264 4:2:0). ``mesh_detail`` is how both draw heavy visual meshes (one of
+    :data:`MESH_DETAILS`); it never changes the physics.
     """
 
     cameras: tuple[str, ...] = ("front", "panda/wrist")
     size: tuple[int, int] = (128, 128)
     critic_size: tuple[int, int] = (320, 240)
+    mesh_detail: str = "lod"
 
     def __post_init__(self) -> None:
         if not self.cameras:
@@ -184,11 +191,21 @@ class RenderConfig:
                                   f"{OFFSCREEN_SIZE[0]}x{OFFSCREEN_SIZE[1]}")
         if any(v % 2 for v in self.size):
             raise ConfigError(f"video size {self.size[0]}x{self.size[1]} must be even")
+        if self.mesh_detail not in MESH_DETAILS:
+            raise ConfigError(f"unknown mesh_detail {self.mesh_detail!r}; choose one of "
+                              f"{', '.join(MESH_DETAILS)}")
 
     def to_dict(self) -> dict[str, Any]:
         return {"cameras": list(self.cameras), "size": list(self.size),
-                "critic_size": list(self.critic_size)}
+                "critic_size": list(self.critic_size), "mesh_detail": self.mesh_detail}
 
     @classmethod
     def from_dict(cls, data: dict[str, Any]) -> RenderConfig:
         return from_fields(cls, data)
+
+
+def cache_dir() -> Path:
+    """Where vcage keeps what it computes once per machine (the arm's reach map, simplified meshes):
+    ``$XDG_CACHE_HOME/vcage``, by default ``~/.cache/vcage``."""
+    root = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
+    return Path(root) / "vcage"

@@ -3,7 +3,8 @@
 Segmentation maps every pixel to the index of a catalog object instance (``world.object_names``),
 :data:`ROBOT` (-2) for the robot, or -1 for the table and background. Renderers hold GL contexts:
 close them explicitly or use
-them as context managers.
+them as context managers. By default heavy visual meshes (the robot's) are drawn simplified
+(:mod:`vcage.sim.lod`); ``mesh_detail="full"`` draws them as shipped.
 """
 
 from __future__ import annotations
@@ -16,6 +17,7 @@ import mujoco
 import numpy as np
 
 from vcage.errors import ConfigError
+from vcage.sim.lod import render_model
 from vcage.sim.world import World
 
 ROBOT = -2  # segmentation label of the robot's pixels
@@ -30,9 +32,13 @@ class CameraFrame:
 
 
 class Renderer:
-    """Renders a :class:`World` at a fixed resolution; dataset quality (no shadows) by default."""
+    """Renders a :class:`World` at a fixed resolution; dataset quality (no shadows) by default.
 
-    def __init__(self, world: World, width: int = 320, height: int = 240) -> None:
+    ``mesh_detail`` (see :data:`vcage.config.MESH_DETAILS`) picks the model drawn: the world's own,
+    or a copy with simplified visual meshes that draws the world's data.
+    """
+
+    def __init__(self, world: World, width: int = 320, height: int = 240, mesh_detail: str = "lod") -> None:
         model = world.model
         if width > model.vis.global_.offwidth or height > model.vis.global_.offheight:
             raise ConfigError(
@@ -41,7 +47,8 @@ class Renderer:
             )
         self.world = world
         self.width, self.height = width, height
-        self._renderer: mujoco.Renderer | None = mujoco.Renderer(model, height, width)
+        self.model = render_model(model, mesh_detail)  # what is drawn; never stepped
+        self._renderer: mujoco.Renderer | None = mujoco.Renderer(self.model, height, width)
         self._cameras = {model.camera(i).name for i in range(model.ncam)}
 
     def _check(self, camera: str) -> mujoco.Renderer:
@@ -96,6 +103,26 @@ class Renderer:
         robot = np.zeros_like(is_geom)
         robot[is_geom] = self.world.geom_is_robot(ids[is_geom])
         out[robot] = ROBOT
+        return out
+
+    def rgb_states(self, states: Sequence[np.ndarray] | np.ndarray,
+                   cameras: Sequence[str]) -> dict[str, np.ndarray]:
+        """RGB frames of ``cameras`` at each of ``states`` (a recording): camera -> ``(len(states),
+        height, width, 3)`` uint8. Each state is set once for all cameras with only the poses
+        drawing needs (:meth:`World.show_state`); the world's state is restored after."""
+        if not cameras:
+            raise ConfigError("name at least one camera to render")
+        renderer = [self._check(camera) for camera in cameras][0]
+        out = {c: np.empty((len(states), self.height, self.width, 3), np.uint8) for c in cameras}
+        current = self.world.get_state()
+        try:
+            for i, state in enumerate(states):
+                self.world.show_state(state)
+                for camera in cameras:
+                    renderer.update_scene(self.world.data, camera=camera)
+                    renderer.render(out=out[camera][i])
+        finally:
+            self.world.set_state(current)
         return out
 
     def frame(self, camera: str, depth: bool = False, segmentation: bool = False) -> CameraFrame:

@@ -10,12 +10,11 @@ from __future__ import annotations
 
 import contextlib
 import hashlib
-import os
 from functools import cache
-from pathlib import Path
 
 import numpy as np
 
+from vcage.config import cache_dir
 from vcage.errors import SkillError
 from vcage.scene.placement.reach import ReachMap
 from vcage.scene.spec import ROBOT_MOUNT
@@ -26,10 +25,6 @@ HEIGHTS = tuple(round(-0.15 + 0.05 * i, 3) for i in range(12))  # -0.15 .. 0.40 
 RADII = tuple(round(0.10 + 0.01 * i, 3) for i in range(81))  # 0.10 .. 0.90 m from the base axis
 VERSION = 1  # bump when the IK model or the criterion changes
 
-
-def cache_dir() -> Path:
-    root = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
-    return Path(root) / "vcage"
 
 
 def compute_reach_map(mount: tuple[float, float, float] = ROBOT_MOUNT) -> ReachMap:
