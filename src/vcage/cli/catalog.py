@@ -19,10 +19,15 @@ def list_catalog(category: str = typer.Option(None, help="only this category"),
     objs = CATALOG.by_category(category) if category else CATALOG.values()
     if tag:
         objs = [o for o in objs if tag in o.tags]
-    table = Table("name", "category", "size (cm)", "grasps", "placements", "functional", "description")
+    # Fits 80 columns: names, categories, sizes and counts never wrap; the description folds.
+    table = Table(caption="size: x, y, z in cm; g/p/f: grasps, placements, functional points",
+                  caption_justify="left")
+    for header in ("name", "category", "size cm"):
+        table.add_column(header, no_wrap=True)
+    table.add_column("g/p/f", no_wrap=True, justify="right")
+    table.add_column("description", overflow="fold")
     for o in objs:
-        table.add_row(o.name, o.category, " x ".join(f"{s * 100:.1f}" for s in o.size),
-                      str(len(o.grasps)), str(len(o.placements)), str(len(o.functional_points)),
-                      o.description)
+        table.add_row(o.name, o.category, "x".join(f"{s * 100:.1f}" for s in o.size),
+                      f"{len(o.grasps)}/{len(o.placements)}/{len(o.functional_points)}", o.description)
     console.print(table)
     console.print(f"{len(objs)} object types")

@@ -3,12 +3,14 @@
 from __future__ import annotations
 
 import json
+import os
 from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import typer
 from rich.table import Table
+from rich.text import Text
 
 from vcage.cli._app import app, console
 from vcage.cli.errors import EXIT_PARTIAL, cli_errors, fail
@@ -79,6 +81,7 @@ def generate_cmd(
         "critic": ("VCAGE_VLM", {"provider": critic_provider, "base_url": critic_url, "model": critic_model,
                                  "timeout": critic_timeout, "max_retries": critic_retries})})
     cfg = cfg.resolved()
+    warn_if_oversubscribed(cfg.executor.name, cfg.executor.workers)
     plan = make_planner(cfg.planner).plan(instruction)  # before any progress is shown
     bar = Progress(TextColumn("{task.description}"), BarColumn(),
                    TextColumn("{task.completed}/{task.total}"), TimeElapsedColumn(), console=console)
@@ -101,7 +104,7 @@ def generate_cmd(
     finally:
         if job is not None:
             bar.stop()
-    _print_funnel(funnel.to_dict(), out)
+    print_funnel(funnel.to_dict(), out)
     if funnel.accepted < funnel.episodes_requested:
         fail(f"only {funnel.accepted} of the {funnel.episodes_requested} episodes asked for were "
              f"accepted ({funnel.given_up} given up after {cfg.max_attempts} attempts each); the "
@@ -153,15 +156,37 @@ def build_config(path: Path | None, mode: str, options: dict[tuple[str, ...], An
     return GenerateConfig.from_dict(tree)
 
 
-def _print_funnel(stats: dict, out: Path) -> None:
+def cores_available() -> int:
+    """The cores this process may run on (its CPU affinity, which containers and taskset narrow)."""
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:  # not on Linux
+        return os.cpu_count() or 1
+
+
+def warn_if_oversubscribed(executor: str, workers: int) -> None:
+    """Warn when local workers outnumber the cores: they would share cores, each episode slower."""
+    cores = cores_available()
+    if executor == "local" and workers > cores:
+        console.print(f"[yellow]warning:[/yellow] --workers {workers} exceeds the {cores} core(s) "
+                      "available to this process: workers will share cores and each episode takes "
+                      f"longer (the dataset is the same); use --workers {cores} or fewer",
+                      highlight=False)
+
+
+def print_funnel(stats: dict, out: Path) -> None:
+    """The run's funnel: attempts by stage, rejections by reason, and a summary; fits 80 columns
+    (long reasons wrap, none is cut)."""
     table = Table("stage", "attempts")
     for stage, n in sorted(stats["stages"].items(), key=lambda kv: -kv[1]):
         table.add_row(stage, str(n))
     console.print(table)
     if stats["rejections_by_reason"]:
-        reasons = Table("rejected at: reason", "attempts")
+        reasons = Table()
+        reasons.add_column("rejected at: reason", overflow="fold")
+        reasons.add_column("attempts", justify="right", no_wrap=True)
         for reason, n in stats["rejections_by_reason"].items():
-            reasons.add_row(reason, str(n))
+            reasons.add_row(Text(reason), str(n))
         console.print(reasons)
     ratio = stats["total_over_physics_and_render"]
     timing = f"; total / (physics + render) = {ratio:.2f}" if ratio else ""

@@ -51,6 +51,7 @@ class Verifier:
         self.world, self.plan, self.critic = world, plan, critic
         self.renderer, self.recording, self.timing = renderer, recording, timing
         self._before: dict[str, View] = {}
+        self.rejected_views: dict[str, dict[str, View]] = {}  # moment -> views of a rejected subtask
 
     def _views(self) -> dict[str, View]:
         if self.renderer is None:
@@ -67,7 +68,10 @@ class Verifier:
         obs = Observation(subtask=self.plan.subtasks[outcome.index], labels=tuple(self.world.object_names),
                           before=self._before, after=self._views(), during=self._deepest(outcome),
                           oracle=outcome.oracle)
-        return self.critic.judge(obs).to_dict()
+        verdict = self.critic.judge(obs)
+        if not verdict.accept:
+            self.rejected_views = {"before": obs.before, "during": obs.during, "after": obs.after}
+        return verdict.to_dict()
 
     def _deepest(self, outcome: Outcome) -> dict[str, View]:
         """Views of the recorded frame where the hand was lowest during the subtask."""
