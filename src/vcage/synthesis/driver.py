@@ -1,0 +1,194 @@
+"""One synthesis run, stage by stage, writing every artefact and the funnel of what each stage refused.
+
+prompt -> retrieval -> D_scene -> scatter + I_init -> I_goal (image editor) -> matching -> refine
+-> settle. Scatter, edit, matching, refine and settle are attempted up to ``attempts`` times with
+fresh seeds; a refusal there is recorded in the funnel and the next attempt starts. Refusals of the
+prompt or the description end the run at once (no seed changes them). Artefacts are written as they
+are made, so what was written before a failure stays.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Protocol
+
+import numpy as np
+
+from vcage.errors import PlacementError, SceneError, VcageError
+from vcage.planning.language import tokens as goal_tokens
+from vcage.planning.offline import OfflinePlanner
+from vcage.scene.instantiate import Instantiator, SceneConfig, SceneInstance
+from vcage.scene.layout import LayoutObject, LayoutSpec
+from vcage.scene.spec import TableSpec
+from vcage.synthesis.compositor import Compositor
+from vcage.synthesis.costs import Problem, Weights
+from vcage.synthesis.describe import describe
+from vcage.synthesis.description import SceneDescription
+from vcage.synthesis.editing import ImageEditor, check_goal_image
+from vcage.synthesis.errors import PromptError, SynthesisError
+from vcage.synthesis.matching import match
+from vcage.synthesis.perturb import PRESETS
+from vcage.synthesis.prompt import check_prompt, noun_phrases
+from vcage.synthesis.refine import RefineConfig, refine
+from vcage.synthesis.retrieval import Retrieval, retriever
+from vcage.synthesis.settle import scene_spec, settle
+from vcage.synthesis.text import content
+from vcage.synthesis.views import render_top
+
+
+class Sink(Protocol):
+    def json(self, name: str, data: Any) -> None: ...
+    def png(self, name: str, image: np.ndarray) -> None: ...
+
+
+class DirectorySink:
+    """Writes artefacts into a directory (created on first write)."""
+
+    def __init__(self, root: Path) -> None:
+        self.root = Path(root)
+
+    def _path(self, name: str) -> Path:
+        path = self.root / name
+        path.parent.mkdir(parents=True, exist_ok=True)
+        return path
+
+    def json(self, name: str, data: Any) -> None:
+        self._path(name).write_text(json.dumps(data, indent=2, default=str))
+
+    def png(self, name: str, image: np.ndarray) -> None:
+        from PIL import Image
+
+        Image.fromarray(np.asarray(image, dtype=np.uint8)).save(self._path(name))
+
+
+class NullSink:
+    def json(self, name: str, data: Any) -> None:
+        pass
+
+    def png(self, name: str, image: np.ndarray) -> None:
+        pass
+
+
+@dataclass(frozen=True)
+class SynthesisConfig:
+    seed: int = 0
+    attempts: int = 3
+    perturbation: str = "none"  # a preset of vcage.synthesis.perturb for the offline compositor
+    lam: float = 1.0
+    settle_seconds: float = 0.5
+    reach: tuple[float, float, float, float] | None = None  # mount x, y, r_in, r_out
+
+    def __post_init__(self) -> None:
+        if self.perturbation not in PRESETS:
+            raise SynthesisError(f"unknown perturbation {self.perturbation!r}; valid: {', '.join(PRESETS)}")
+        if self.attempts < 1:
+            raise SynthesisError(f"attempts must be >= 1, got {self.attempts}")
+
+
+@dataclass
+class SynthesisResult:
+    description: SceneDescription
+    instance: SceneInstance
+    funnel: list[dict[str, Any]] = field(default_factory=list)
+
+
+def unknown_phrases(text: str) -> tuple[list[str], dict[str, Retrieval]]:
+    """Noun phrases that name nothing in the catalog nor a goal word, and every phrase's retrieval."""
+    vocab = OfflinePlanner().matcher.vocabulary
+    found: dict[str, Retrieval] = {}
+    unknown = []
+    for phrase in noun_phrases(text):
+        if not content(phrase):
+            continue
+        found[phrase] = retriever().search(phrase, k=3)
+        if not found[phrase].found and not set(goal_tokens(phrase)) & vocab:
+            unknown.append(phrase)
+    return unknown, found
+
+
+def synthesize(prompt: str, cfg: SynthesisConfig | None = None, sink: Sink | None = None,
+               editor: ImageEditor | None = None) -> SynthesisResult:
+    cfg = cfg or SynthesisConfig()
+    sink = sink or NullSink()
+    funnel: list[dict[str, Any]] = []
+
+    def record(stage: str, status: str, detail: Any = None, attempt: int | None = None) -> None:
+        funnel.append({"stage": stage, "status": status, "attempt": attempt, "detail": detail})
+        sink.json("funnel.json", funnel)
+
+    try:
+        text = check_prompt(prompt)
+    except PromptError as exc:
+        record("prompt", "rejected", str(exc))
+        raise
+    scene_hits = retriever().search(text, k=10)
+    unknown, phrases = unknown_phrases(text)
+    sink.json("retrieval.json", {"prompt": scene_hits.to_dict(),
+                                 "phrases": {p: r.to_dict() for p, r in phrases.items()}, "unknown": unknown})
+    if unknown:
+        names = ", ".join(repr(u) for u in unknown)
+        msg = (f"the prompt names {names}, which the catalog lacks: name catalog "
+               "objects (`vcage catalog` lists them)")
+        record("retrieval", "rejected", msg)
+        raise PromptError(msg)
+    record("retrieval", "ok", {"best": scene_hits.names()[:5], "no_match": scene_hits.no_match})
+    try:
+        desc, source = describe(text, scene_hits)
+    except SynthesisError as exc:
+        record("description", "rejected", str(exc))
+        raise
+    sink.json("scene_description.json", {"source": source.kind, "score": source.score, **desc.model_dump()})
+    record("description", "ok", {"source": source.kind, "objects": len(desc.objects),
+                                 "relations": [str(r) for r in desc.relations]})
+    editor = editor or Compositor(PRESETS[cfg.perturbation])
+    table = TableSpec()
+    last: VcageError | None = None
+    for attempt in range(cfg.attempts):
+        rng = np.random.default_rng([cfg.seed, attempt])
+        try:
+            inst = _attempt(desc, cfg, editor, table, rng, sink, record, attempt)
+            return SynthesisResult(desc, inst, funnel)
+        except (SynthesisError, SceneError) as exc:
+            stage = exc.stage if isinstance(exc, SynthesisError) else (
+                "scatter" if isinstance(exc, PlacementError) else "scene")
+            record(stage, "rejected", str(exc), attempt)
+            last = exc
+    raise SynthesisError(f"no valid scene for {text!r} after {cfg.attempts} attempts; last: {last}. "
+                         "Try another seed, more attempts, or a prompt with fewer objects")
+
+
+def _attempt(desc: SceneDescription, cfg: SynthesisConfig, editor: ImageEditor, table: TableSpec,
+             rng: np.random.Generator, sink: Sink, record: Any, attempt: int) -> SceneInstance:
+    where = f"attempt-{attempt}/"
+    layout = LayoutSpec(objects=tuple(LayoutObject(o.name, o.type, scale=o.scale, color=o.color)
+                                      for o in desc.objects), table=table)
+    scattered = Instantiator(SceneConfig(settle_seconds=cfg.settle_seconds)).instantiate(layout, rng)
+    scattered.require_valid("the scattered objects")
+    view, empty = render_top(scattered.world)
+    sink.png(where + "I_init.png", view.rgb)
+    sink.png(where + "empty_table.png", empty)
+    record("scatter", "ok", {"objects": len(view.names)}, attempt)
+    edit = editor.edit(view, empty, desc, rng)
+    goal = check_goal_image(edit.image, view)
+    sink.png(where + "I_goal.png", goal)
+    if edit.truth is not None:
+        sink.json(where + "goal_truth.json", {"poses": edit.truth, "dropped": edit.dropped, **edit.info})
+    record("edit", "ok", {"editor": editor.name}, attempt)
+    looks = {o.name: (o.type, o.color, o.scale) for o in desc.objects}
+    stacked = {frozenset((r.a, r.b)) for r in desc.relations if r.kind in ("on", "inside")}
+    report = match(view, empty, goal, looks, stacked)
+    sink.json(where + "matches.json", report.to_dict())
+    record("matching", "ok" if not report.lost else "partial", {"lost": report.lost}, attempt)
+    problem = Problem.build(desc, table, reach=cfg.reach)
+    matched = {n: (m.xy[0], m.xy[1], m.yaw) for n, m in report.matches.items()}
+    result = refine(problem, matched, RefineConfig(weights=Weights(lam=cfg.lam)), rng)
+    sink.json(where + "refined_poses.json", result.to_dict())
+    record("refine", "ok", {"start": result.start, "mean_displacement_m": round(result.displacement, 4)},
+           attempt)
+    spec = scene_spec(desc, result.poses, table)
+    inst = settle(spec, cfg.settle_seconds)
+    sink.json("scene_spec.json", spec.to_dict())
+    record("settle", "ok", {"stability": inst.stability.reason() if inst.stability else None}, attempt)
+    return inst

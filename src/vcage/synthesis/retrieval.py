@@ -1,0 +1,141 @@
+"""Language-guided asset retrieval: rank the annotated catalog against a request by meaning.
+
+Each catalog type is a document of its name, category, description, tags and affordances (what
+can be grasped, what holds objects on or in it, what has a button or a switch). A request is
+ranked by BM25 over synonym-expanded words and by character n-gram TF-IDF (for misspellings), and
+the two rankings are fused by reciprocal rank. Affordance filters keep only types that can do what
+the scene needs. A request whose words name nothing the catalog has gets an answer with no hits
+and the reason: "no suitable object" is a result, not an error.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Literal
+
+from vcage.assets.catalog import CATALOG, ObjectType
+from vcage.errors import ConfigError
+from vcage.synthesis.bm25 import BM25
+from vcage.synthesis.text import char_ngrams, content, expand, tokens
+from vcage.synthesis.tfidf import CharTfidf
+
+Affordance = Literal["grasp", "support", "container", "placement", "functional"]
+AFFORDANCES: tuple[str, ...] = ("grasp", "support", "container", "placement", "functional")
+RRF_K = 60  # reciprocal rank fusion constant (Cormack et al.)
+NAME_REPEAT = 3  # a type's own name words count this many times in its document
+TYPO_COSINE = 0.45  # without a shared word, an n-gram cosine this high still counts (a misspelling)
+MIN_COSINE = 0.1  # below this the n-gram ranking does not vote for a type
+
+
+def affords(t: ObjectType, need: str) -> bool:
+    if need == "grasp":
+        return bool(t.grasps)
+    if need == "support":
+        return any(p.kind == "on" for p in t.placements)
+    if need == "container":
+        return any(p.kind == "in" for p in t.placements)
+    if need == "placement":
+        return bool(t.placements)
+    if need == "functional":
+        return bool(t.functional_points)
+    raise ConfigError(f"unknown affordance {need!r}; valid: {', '.join(AFFORDANCES)}")
+
+
+def document(t: ObjectType) -> str:
+    """The words a type is found by."""
+    parts = [" ".join([t.name.replace("_", " ")] * NAME_REPEAT), t.category, t.description,
+             " ".join(sorted(t.tags))]
+    if t.grasps:
+        parts.append("graspable pick")
+    for p in t.placements:
+        parts.append("support surface holds objects on top" if p.kind == "on" else "container holds inside")
+    for f in t.functional_points:
+        parts.append(f"{f.kind} press functional")
+    return " ".join(parts)
+
+
+@dataclass(frozen=True)
+class Hit:
+    type: str
+    score: float  # fused reciprocal-rank score (higher is better)
+    bm25: float
+    cosine: float
+
+    def to_dict(self) -> dict[str, object]:
+        return {"type": self.type, "score": round(self.score, 5), "bm25": round(self.bm25, 4),
+                "cosine": round(self.cosine, 4)}
+
+
+@dataclass(frozen=True)
+class Retrieval:
+    """The answer to one request: hits best first, or none and the reason (``no_match``)."""
+
+    query: str
+    hits: tuple[Hit, ...] = ()
+    no_match: str | None = None
+    filters: tuple[str, ...] = field(default=())
+
+    @property
+    def found(self) -> bool:
+        return bool(self.hits)
+
+    @property
+    def best(self) -> str | None:
+        return self.hits[0].type if self.hits else None
+
+    def names(self) -> list[str]:
+        return [h.type for h in self.hits]
+
+    def to_dict(self) -> dict[str, object]:
+        return {"query": self.query, "filters": list(self.filters), "no_match": self.no_match,
+                "hits": [h.to_dict() for h in self.hits]}
+
+
+class Retriever:
+    """Ranks catalog types against text; built once over the catalog (or any list of types)."""
+
+    def __init__(self, types: list[ObjectType] | None = None) -> None:
+        self.types = list(types) if types is not None else list(CATALOG.values())
+        docs = [document(t) for t in self.types]
+        self.bm25 = BM25([tokens(d) for d in docs])
+        self.tfidf = CharTfidf([char_ngrams(d) for d in docs])
+
+    def search(self, query: str, k: int = 5, require: tuple[str, ...] = ()) -> Retrieval:
+        """The ``k`` best types for ``query`` that afford everything in ``require``."""
+        for need in require:
+            affords(self.types[0], need)  # unknown affordances raise, even before matching
+        if not content(query):
+            return Retrieval(query, no_match="the request names no object (only stop words or generic "
+                                             "words such as 'thing')", filters=require)
+        weights = {t: w for t, w in expand(query).items() if t in self.bm25.vocabulary}
+        bm = self.bm25.scores(weights) if weights else [0.0] * len(self.types)
+        cos = self.tfidf.scores(char_ngrams(" ".join(content(query))))
+        keep = [i for i, t in enumerate(self.types)
+                if all(affords(t, n) for n in require) and (bm[i] > 0 or cos[i] >= TYPO_COSINE)]
+        if not keep:
+            why = ("no catalog type affords " + ", ".join(require)) if require and (
+                any(b > 0 for b in bm) or max(cos) >= TYPO_COSINE) else "no catalog type matches its words"
+            return Retrieval(query, no_match=why, filters=require)
+        rank_bm = sorted(keep, key=lambda i: (-bm[i], self.types[i].name))
+        rank_cos = sorted(keep, key=lambda i: (-cos[i], self.types[i].name))
+        fused = {i: 0.0 for i in keep}
+        for r, i in enumerate(rank_bm):
+            if bm[i] > 0:
+                fused[i] += 1.0 / (RRF_K + r + 1)
+        for r, i in enumerate(rank_cos):
+            if cos[i] >= MIN_COSINE:
+                fused[i] += 1.0 / (RRF_K + r + 1)
+        order = sorted(keep, key=lambda i: (-fused[i], -bm[i], -cos[i], self.types[i].name))[:k]
+        return Retrieval(query, tuple(Hit(self.types[i].name, fused[i], bm[i], cos[i]) for i in order),
+                         filters=require)
+
+
+_DEFAULT: Retriever | None = None
+
+
+def retriever() -> Retriever:
+    """The retriever over the whole catalog, built on first use."""
+    global _DEFAULT
+    if _DEFAULT is None:
+        _DEFAULT = Retriever()
+    return _DEFAULT
