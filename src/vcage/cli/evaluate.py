@@ -1,0 +1,75 @@
+"""``vcage evaluate``: a checkpoint's success rate in its dataset's evaluation environment."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import typer
+from rich.table import Table
+
+from vcage.cli._app import app, console
+from vcage.cli.errors import cli_errors
+
+
+@app.command("evaluate")
+@cli_errors
+def evaluate_cmd(
+        checkpoint: Path = typer.Argument(..., help="a checkpoint file, or a `vcage train` --out directory "
+                                          "(its latest checkpoint)"),
+        episodes: int = typer.Option(10, min=1, help="evaluation episodes"),
+        seed: int = typer.Option(0, min=0, help="evaluation seed (scenes never seen in training)"),
+        max_steps: int = typer.Option(None, min=1, help="control steps before an episode is cut "
+                                      "(default: 600 per subtask)"),
+        env: Path = typer.Option(None, help="evaluate in the environment of this dataset instead of the "
+                                 "one the checkpoint was trained on"),
+        device: str = typer.Option("cpu", help="cpu, or cuda when a GPU is present"),
+        threads: int = typer.Option(None, min=1, help="torch CPU threads (default: torch's choice)"),
+        json_out: Path = typer.Option(None, "--json",
+                                      help="also write the results to this JSON file")) -> None:
+    """Roll out CHECKPOINT for --episodes episodes: success rate (Wilson 95% interval), progress per
+    subtask, rollouts per minute."""
+    from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
+
+    from vcage.data import DatasetReader
+    from vcage.policy.evaluate import evaluate
+
+    env_config = DatasetReader(env).config if env is not None else None
+    if env is not None and not env_config:
+        from vcage.errors import DatasetError
+
+        raise DatasetError(f"{env} stores no vcage configuration (meta/vcage.json); choose a vcage dataset")
+    bar = Progress(TextColumn("{task.description}"), BarColumn(), TextColumn("{task.completed}/{task.total}"),
+                   TimeElapsedColumn(), console=console)
+    job = bar.add_task("episodes", total=episodes)
+    wins = 0
+
+    def update(done: int, total: int, result: object) -> None:
+        nonlocal wins
+        if not bar.live.is_started:
+            bar.start()
+        wins += bool(getattr(result, "success", False))
+        bar.update(job, completed=done, description=f"episodes ({wins} successes)")
+
+    try:
+        result = evaluate(checkpoint, episodes, seed=seed, max_steps=max_steps, env_config=env_config,
+                          device=device, threads=threads, progress=update)
+    finally:
+        if bar.live.is_started:
+            bar.stop()
+    low, high = result.interval
+    table = Table(title=f"evaluation of {result.checkpoint}")
+    table.add_column("")
+    table.add_column("value", justify="right")
+    table.add_row("success rate", f"{result.success_rate:.1%} ({result.successes}/{len(result.episodes)})")
+    table.add_row("Wilson 95% interval", f"[{low:.1%}, {high:.1%}]")
+    table.add_row("mean progress", f"{result.mean_progress:.1%}")
+    for i, share in enumerate(result.subtask_progress):
+        name = result.subtask_names[i] if i < len(result.subtask_names) else ""
+        table.add_row(f"subtask {i + 1} done{': ' + name if name else ''}", f"{share:.1%}")
+    table.add_row("rollouts/minute", f"{result.rollouts_per_minute:.2f}")
+    table.add_row("seed", str(seed))
+    console.print(table)
+    if json_out is not None:
+        json_out.write_text(json.dumps(result.to_dict(), indent=2) + "\n")
+        console.print(f"wrote {json_out}")

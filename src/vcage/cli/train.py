@@ -1,0 +1,72 @@
+"""``vcage train``: a policy trained on a dataset, checkpointed into a run directory."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import typer
+from rich.table import Table
+
+from vcage.cli._app import app, console
+from vcage.cli.errors import cli_errors
+
+
+@app.command("train")
+@cli_errors
+def train_cmd(
+        dataset: Path = typer.Argument(..., help="a dataset directory (LeRobot v3)"),
+        out: Path = typer.Option(..., help="run directory: checkpoints go to OUT/checkpoints/"),
+        policy: str = typer.Option(None, help="diffusion (default) or mlp"),
+        steps: int = typer.Option(None, help="optimiser steps in all (default 3000)"),
+        batch_size: int = typer.Option(None, help="samples per step (default 64)"),
+        lr: float = typer.Option(None, help="peak learning rate (default 3e-4)"),
+        seed: int = typer.Option(None, help="seed of the weights, batches and noise (default 0)"),
+        checkpoint_every: int = typer.Option(None, help="steps between checkpoints (default 500)"),
+        obs: str = typer.Option(None, help="comma-separated observation features (default: "
+                                "observation.state, observation.ee_pose and observation.environment_state "
+                                "if the dataset has it)"),
+        resume: bool = typer.Option(False, help="continue the run in OUT from its last checkpoint (only "
+                                    "--steps may change)"),
+        device: str = typer.Option("cpu", help="cpu, or cuda when a GPU is present"),
+        threads: int = typer.Option(None, min=1, help="torch CPU threads (default: torch's choice)")) -> None:
+    """Train a policy on DATASET: deterministic on the CPU given --seed, resumable with --resume."""
+    from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn, TimeRemainingColumn
+
+    from vcage.policy.config import TrainConfig
+    from vcage.policy.train import stored_config, train
+
+    given: dict[str, Any] = {"policy": policy, "steps": steps, "batch_size": batch_size, "lr": lr,
+                             "seed": seed, "checkpoint_every": checkpoint_every,
+                             "observation_keys": tuple(k.strip() for k in obs.split(",") if k.strip())
+                             if obs else None}
+    given = {k: v for k, v in given.items() if v is not None}
+    base = stored_config(out) if resume else None
+    config = TrainConfig.from_dict({**(base.to_dict() if base else {}), **given})
+    bar = Progress(TextColumn("{task.description}"), BarColumn(), TextColumn("{task.completed}/{task.total}"),
+                   TimeElapsedColumn(), TimeRemainingColumn(), console=console)
+    job = bar.add_task(f"training {config.policy}", total=config.steps)
+
+    def update(step: int, total: int, loss: float) -> None:
+        if not bar.live.is_started:
+            bar.start()
+        bar.update(job, completed=step, description=f"training {config.policy} (loss {loss:.4f})")
+
+    try:
+        summary = train(dataset, out, config, resume=resume, device=device, threads=threads, progress=update)
+    finally:
+        if bar.live.is_started:
+            bar.stop()
+    for note in summary.notes:
+        console.print(f"[yellow]note:[/yellow] {note}")
+    table = Table(title=f"{config.policy} policy on {dataset}")
+    table.add_column("")
+    table.add_column("value", justify="right")
+    table.add_row("steps", f"{summary.start_step} -> {summary.steps}" if summary.start_step
+                  else str(summary.steps))
+    table.add_row("final loss (mean of last 50 steps)", f"{summary.final_loss:.5f}")
+    table.add_row("samples/s", f"{summary.samples_per_second:,.0f}")
+    table.add_row("training time", f"{summary.seconds:.1f} s")
+    table.add_row("parameters", f"{summary.parameters:,}")
+    table.add_row("checkpoint", str(summary.checkpoint))
+    console.print(table)

@@ -1,0 +1,139 @@
+"""The configuration of a training run, as frozen data (no torch): stored in every checkpoint.
+
+Defaults are sized for a CPU: the diffusion U-Net has about 1.2 M parameters and the MLP about
+0.35 M (with the 22 observation values of a one-object dataset); both train their default steps in
+minutes on one core. The window sizes follow Diffusion Policy (and LeRobot's
+``delta_timestamps`` for it): 2 observation frames (previous and current), a 16-step action chunk
+starting at the previous frame, of which 8 are executed from the current frame on.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass, field
+from typing import Any
+
+from vcage.config import from_fields
+from vcage.errors import ConfigError
+
+POLICY_KINDS = ("diffusion", "mlp")
+OBS_NORMS = ("min_max", "mean_std")
+# The observation features used when none are named: those of the list the dataset has.
+DEFAULT_OBSERVATIONS = ("observation.state", "observation.ee_pose", "observation.environment_state")
+REQUIRED_OBSERVATIONS = ("observation.state", "observation.ee_pose")
+ACTION = "action"
+
+
+def _positive(owner: str, **values: float) -> None:
+    for name, value in values.items():
+        if isinstance(value, bool) or not isinstance(value, int | float) or not value > 0 \
+                or not math.isfinite(value):
+            raise ConfigError(f"{owner}.{name} must be a positive number, got {value!r}")
+
+
+@dataclass(frozen=True)
+class DiffusionConfig:
+    """The diffusion policy: a 1D temporal U-Net (Chi et al. 2023), DDPM training, DDIM sampling."""
+
+    down_dims: tuple[int, ...] = (32, 64, 128)  # channels of the U-Net's levels (16 -> 8 -> 4 steps)
+    kernel_size: int = 5
+    n_groups: int = 8  # GroupNorm groups; every entry of down_dims must be divisible by it
+    step_embed_dim: int = 64  # sinusoidal embedding of the diffusion step
+    train_timesteps: int = 100  # DDPM steps, squared-cosine noise schedule
+    inference_steps: int = 10  # DDIM steps at inference
+    clip_sample: bool = True  # clip the predicted clean chunk to the normalised range [-1, 1]
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "down_dims", tuple(int(d) for d in self.down_dims))
+        if not self.down_dims:
+            raise ConfigError("diffusion.down_dims needs at least one level, e.g. (64, 128, 256)")
+        _positive("diffusion", kernel_size=self.kernel_size, n_groups=self.n_groups,
+                  step_embed_dim=self.step_embed_dim, train_timesteps=self.train_timesteps,
+                  inference_steps=self.inference_steps, **{f"down_dims[{i}]": d
+                                                            for i, d in enumerate(self.down_dims)})
+        if any(d % self.n_groups for d in self.down_dims):
+            raise ConfigError(f"diffusion.down_dims {self.down_dims} must all be divisible by n_groups "
+                              f"{self.n_groups}")
+        if self.kernel_size % 2 == 0:
+            raise ConfigError(f"diffusion.kernel_size must be odd (same-length convolutions), got "
+                              f"{self.kernel_size}")
+        if self.inference_steps > self.train_timesteps:
+            raise ConfigError(f"diffusion.inference_steps ({self.inference_steps}) cannot exceed "
+                              f"train_timesteps ({self.train_timesteps})")
+        if self.step_embed_dim % 2:
+            raise ConfigError(f"diffusion.step_embed_dim must be even, got {self.step_embed_dim}")
+
+
+@dataclass(frozen=True)
+class MlpConfig:
+    """The behaviour-cloning baseline: an MLP from the observation window to the action chunk."""
+
+    hidden: tuple[int, ...] = (512, 512)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "hidden", tuple(int(h) for h in self.hidden))
+        _positive("mlp", **{f"hidden[{i}]": h for i, h in enumerate(self.hidden)})
+
+
+@dataclass(frozen=True)
+class TrainConfig:
+    """One training run: the policy, its sizes, the optimisation and the observation features."""
+
+    policy: str = "diffusion"
+    steps: int = 3000
+    batch_size: int = 64
+    lr: float = 3e-4  # AdamW, linear warm-up then cosine decay to 0
+    weight_decay: float = 1e-6
+    warmup_steps: int = 100
+    grad_clip: float = 10.0  # max gradient norm
+    seed: int = 0
+    checkpoint_every: int = 500
+    observation_keys: tuple[str, ...] | None = None  # None: DEFAULT_OBSERVATIONS the dataset has
+    obs_norm: str = "min_max"  # observations to [-1, 1] (min_max) or to zero mean, unit std (mean_std)
+    n_obs_steps: int = 2
+    horizon: int = 16
+    n_action_steps: int = 8
+    ema_power: float = 0.75  # EMA decay 1 - (1 + step) ** -power, at most ema_max_decay
+    ema_max_decay: float = 0.9999
+    diffusion: DiffusionConfig = field(default_factory=DiffusionConfig)
+    mlp: MlpConfig = field(default_factory=MlpConfig)
+
+    def __post_init__(self) -> None:
+        if self.policy not in POLICY_KINDS:
+            raise ConfigError(f"unknown policy {self.policy!r}; valid: {', '.join(POLICY_KINDS)}")
+        if self.obs_norm not in OBS_NORMS:
+            raise ConfigError(f"unknown obs_norm {self.obs_norm!r}; valid: {', '.join(OBS_NORMS)}")
+        for name in ("steps", "batch_size", "checkpoint_every", "n_obs_steps", "horizon", "n_action_steps"):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, int) or value < 1:
+                raise ConfigError(f"{name} must be a positive integer, got {value!r}")
+        if isinstance(self.seed, bool) or not isinstance(self.seed, int) or self.seed < 0:
+            raise ConfigError(f"seed must be a non-negative integer, got {self.seed!r}")
+        if isinstance(self.warmup_steps, bool) or not isinstance(self.warmup_steps, int) \
+                or self.warmup_steps < 0:
+            raise ConfigError(f"warmup_steps must be a non-negative integer, got {self.warmup_steps!r}")
+        _positive("train", lr=self.lr, grad_clip=self.grad_clip, ema_power=self.ema_power)
+        if not 0 <= self.weight_decay < 1:
+            raise ConfigError(f"weight_decay must be in [0, 1), got {self.weight_decay}")
+        if not 0 <= self.ema_max_decay < 1:
+            raise ConfigError(f"ema_max_decay must be in [0, 1), got {self.ema_max_decay}")
+        if self.n_obs_steps - 1 + self.n_action_steps > self.horizon:
+            raise ConfigError(f"the executed actions (n_action_steps {self.n_action_steps}, from the "
+                              f"current frame, which is step {self.n_obs_steps - 1} of the chunk) must "
+                              f"fit in the horizon {self.horizon}")
+        if self.policy == "diffusion" and self.horizon % 2 ** (len(self.diffusion.down_dims) - 1):
+            raise ConfigError(f"horizon {self.horizon} must be divisible by 2 ** (levels - 1) = "
+                              f"{2 ** (len(self.diffusion.down_dims) - 1)} for the U-Net's down-sampling")
+        if self.observation_keys is not None:
+            keys = tuple(str(k) for k in self.observation_keys)
+            if not keys or len(set(keys)) != len(keys) or ACTION in keys:
+                raise ConfigError(f"observation_keys must be distinct feature names other than "
+                                  f"{ACTION!r}, got {self.observation_keys!r}")
+            object.__setattr__(self, "observation_keys", keys)
+
+    def to_dict(self) -> dict[str, Any]:
+        return asdict(self)
+
+    @classmethod
+    def from_dict(cls, data: Any) -> TrainConfig:
+        return from_fields(cls, data, diffusion=DiffusionConfig, mlp=MlpConfig)

@@ -1,0 +1,143 @@
+"""The frames a policy trains on, read from a LeRobot v3 dataset through :class:`DatasetReader`
+(no torch): the chosen observation features side by side, the actions, the episode lengths, and
+the dataset's fingerprint.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from vcage.data.reader import DatasetReader
+from vcage.errors import DatasetError
+from vcage.policy.config import ACTION, DEFAULT_OBSERVATIONS, REQUIRED_OBSERVATIONS, TrainConfig
+from vcage.policy.errors import MissingFeatureError
+
+MIN_EPISODES = 2
+
+
+@dataclass(frozen=True)
+class FeatureSpec:
+    """A vector feature as a policy uses it: name, size and element names (if the dataset has them)."""
+
+    name: str
+    size: int
+    names: tuple[str, ...] | None = None
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"name": self.name, "size": self.size, "names": list(self.names) if self.names else None}
+
+    @classmethod
+    def from_dict(cls, data: dict[str, Any]) -> FeatureSpec:
+        names = data.get("names")
+        return cls(str(data["name"]), int(data["size"]), tuple(names) if names else None)
+
+
+@dataclass(frozen=True)
+class DatasetInfo:
+    """What a checkpoint records of the dataset it was trained on."""
+
+    path: str
+    fingerprint: str
+    fps: int
+    episodes: int
+    frames: int
+    config: dict[str, Any] | None  # meta/vcage.json's configuration: how to make its environment
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"path": self.path, "fingerprint": self.fingerprint, "fps": self.fps,
+                "episodes": self.episodes, "frames": self.frames, "config": self.config}
+
+    @classmethod
+    def from_dict(cls, data: dict[str, Any]) -> DatasetInfo:
+        return cls(str(data["path"]), str(data["fingerprint"]), int(data["fps"]), int(data["episodes"]),
+                   int(data["frames"]), data.get("config"))
+
+
+@dataclass(frozen=True, eq=False)
+class TrainingData:
+    """All frames of a dataset: ``obs`` (N, obs_dim) float32 (the features of ``obs_features``
+    side by side), ``action`` (N, action_dim) float32, ``lengths`` of the episodes in order."""
+
+    obs: np.ndarray
+    action: np.ndarray
+    lengths: tuple[int, ...]
+    obs_features: tuple[FeatureSpec, ...]
+    action_feature: FeatureSpec
+    info: DatasetInfo
+    notes: tuple[str, ...] = field(default=())  # things the user should know (e.g. a feature left out)
+
+
+def fingerprint(reader: DatasetReader) -> str:
+    """A hash of what makes a dataset's content: its features, episode and frame counts, fps, and the
+    configuration it was generated with."""
+    content = {"features": reader.info.get("features"), "episodes": reader.num_episodes,
+               "frames": reader.total_frames, "fps": reader.fps, "config": reader.config}
+    return hashlib.sha256(json.dumps(content, sort_keys=True, default=str).encode()).hexdigest()[:16]
+
+
+def observation_keys(reader: DatasetReader,
+                     keys: tuple[str, ...] | None) -> tuple[tuple[str, ...], list[str]]:
+    """The observation features to use and notes: ``keys``, or the defaults the dataset has."""
+    root = reader.root
+    wanted = keys if keys is not None else REQUIRED_OBSERVATIONS
+    for key in (*wanted, ACTION):
+        if key not in reader.features:
+            raise MissingFeatureError(
+                f"the dataset {root} has no feature {key!r} (it has {', '.join(sorted(reader.features))}); "
+                f"run `vcage backfill {root}` to add the features policies train on"
+                + ("" if keys is None else ", or choose other observation features"))
+    if keys is not None:
+        return keys, []
+    chosen = tuple(k for k in DEFAULT_OBSERVATIONS if k in reader.features)
+    notes = [f"the dataset has no {k!r}: the policy does not observe it (run `vcage backfill {root}` to "
+             "add it)" for k in DEFAULT_OBSERVATIONS if k not in reader.features]
+    return chosen, notes
+
+
+def load_training_data(root: str | Path, config: TrainConfig) -> TrainingData:
+    """Read every episode of the dataset at ``root`` with the features ``config`` asks for.
+
+    Raises:
+        DatasetError: not a dataset, fewer than two episodes, or non-finite values.
+        MissingFeatureError: a needed feature is absent (the message names the back-fill command).
+    """
+    reader = DatasetReader(root)
+    if reader.num_episodes < MIN_EPISODES:
+        raise DatasetError(f"the dataset {reader.root} has {reader.num_episodes} episode(s); training needs "
+                           f"at least {MIN_EPISODES} (`vcage generate ... --out {reader.root} --episodes N "
+                           "--total` adds more)")
+    keys, notes = observation_keys(reader, config.observation_keys)
+    obs_parts: list[list[np.ndarray]] = [[] for _ in keys]
+    actions, lengths = [], []
+    for i in range(reader.num_episodes):
+        frames = reader.episode(i).frames
+        for part, key in zip(obs_parts, keys, strict=True):
+            part.append(_vectors(frames[key], key, i, reader.root))
+        actions.append(_vectors(frames[ACTION], ACTION, i, reader.root))
+        lengths.append(len(actions[-1]))
+    obs = np.concatenate([np.concatenate(p) for p in obs_parts], axis=1)
+    specs = tuple(_spec(reader, k) for k in keys)
+    info = DatasetInfo(str(reader.root), fingerprint(reader), reader.fps, reader.num_episodes,
+                       reader.total_frames, reader.config)
+    return TrainingData(obs, np.concatenate(actions), tuple(lengths), specs, _spec(reader, ACTION), info,
+                        tuple(notes))
+
+
+def _spec(reader: DatasetReader, key: str) -> FeatureSpec:
+    feature = reader.features[key]
+    return FeatureSpec(key, int(feature.shape[0]), tuple(feature.names) if feature.names else None)
+
+
+def _vectors(values: np.ndarray, key: str, episode: int, root: Path) -> np.ndarray:
+    x = np.asarray(values, dtype=np.float32)
+    x = x.reshape(len(x), -1)
+    if not np.isfinite(x).all():
+        raise DatasetError(f"{root}: feature {key!r} of episode {episode} holds NaN or infinite values; "
+                           "`vcage verify` the dataset, or drop the episode")
+    return x

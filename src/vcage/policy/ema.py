@@ -1,0 +1,37 @@
+"""An exponential moving average of a model's weights (Diffusion Policy's EMA schedule)."""
+
+from __future__ import annotations
+
+import copy
+
+import torch
+from torch import nn
+
+
+class Ema:
+    """Keeps ``model``'s averaged copy: decay ``1 - (1 + step) ** -power``, capped at ``max_decay``
+    (so early steps follow the weights closely and later ones average over more steps)."""
+
+    def __init__(self, model: nn.Module, power: float, max_decay: float) -> None:
+        self.model = copy.deepcopy(model).eval().requires_grad_(False)
+        self.power, self.max_decay = power, max_decay
+        self.updates = 0
+
+    def decay(self) -> float:
+        return min(self.max_decay, max(0.0, 1 - (1 + self.updates) ** -self.power))
+
+    @torch.no_grad()
+    def update(self, model: nn.Module) -> None:
+        decay = self.decay()
+        for averaged, current in zip(self.model.parameters(), model.parameters(), strict=True):
+            averaged.mul_(decay).add_(current.detach(), alpha=1 - decay)
+        for kept, buffer in zip(self.model.buffers(), model.buffers(), strict=True):
+            kept.copy_(buffer)
+        self.updates += 1
+
+    def state_dict(self) -> dict[str, object]:
+        return {"model": self.model.state_dict(), "updates": self.updates}
+
+    def load_state_dict(self, state: dict[str, object]) -> None:
+        self.model.load_state_dict(state["model"])  # type: ignore[arg-type]
+        self.updates = int(state["updates"])  # type: ignore[call-overload]

@@ -1,0 +1,184 @@
+"""Evaluating a checkpoint: rollouts in its dataset's evaluation environment, success statistics.
+
+The environment comes from :func:`vcage.pipeline.evaluation.make_env` with the configuration the
+dataset stored (``meta/vcage.json``), or another dataset's. Before any rollout the checkpoint's
+observation features (names, sizes, element names), action size and control rate are checked
+against the environment's; a difference raises :class:`EnvironmentMismatchError`.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Mapping
+from dataclasses import asdict, dataclass
+from pathlib import Path
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+import torch
+
+from vcage.policy.checkpoint import load_checkpoint
+from vcage.policy.devices import torch_device
+from vcage.policy.errors import EnvironmentMismatchError, PolicyError
+from vcage.policy.inference import PolicyRunner
+from vcage.policy.metrics import subtask_reached, wilson_interval
+
+EnvFactory = Callable[..., gym.Env]  # (config, *, seed, max_steps) -> env, as make_env
+
+
+@dataclass(frozen=True)
+class EpisodeResult:
+    success: bool
+    subtasks_done: int
+    subtasks: int
+    progress: float
+    steps: int
+    scene_seed: int | None
+
+
+@dataclass(frozen=True)
+class Evaluation:
+    """The episodes of one evaluation and their statistics."""
+
+    checkpoint: str
+    seed: int
+    episodes: tuple[EpisodeResult, ...]
+    seconds: float
+    subtask_names: tuple[str, ...] = ()  # the plan's subtask descriptions, when the config has a plan
+
+    @property
+    def successes(self) -> int:
+        return sum(e.success for e in self.episodes)
+
+    @property
+    def success_rate(self) -> float:
+        return self.successes / len(self.episodes) if self.episodes else 0.0
+
+    @property
+    def interval(self) -> tuple[float, float]:
+        return wilson_interval(self.successes, len(self.episodes))
+
+    @property
+    def subtask_progress(self) -> list[float]:
+        """Share of the episodes that completed each subtask (in the plan's order)."""
+        n = max((e.subtasks for e in self.episodes), default=len(self.subtask_names))
+        return subtask_reached([e.subtasks_done for e in self.episodes], n)
+
+    @property
+    def mean_progress(self) -> float:
+        return float(np.mean([e.progress for e in self.episodes])) if self.episodes else 0.0
+
+    @property
+    def rollouts_per_minute(self) -> float:
+        return 60 * len(self.episodes) / self.seconds if self.seconds > 0 else 0.0
+
+    def to_dict(self) -> dict[str, Any]:
+        low, high = self.interval
+        return {"checkpoint": self.checkpoint, "seed": self.seed, "episodes": len(self.episodes),
+                "successes": self.successes, "success_rate": self.success_rate,
+                "wilson95": [low, high], "subtask_progress": self.subtask_progress,
+                "subtask_names": list(self.subtask_names), "mean_progress": self.mean_progress,
+                "seconds": self.seconds, "rollouts_per_minute": self.rollouts_per_minute,
+                "per_episode": [asdict(e) for e in self.episodes]}
+
+
+def check_compatible(checkpoint: Mapping[str, Any], env: gym.Env) -> None:
+    """EnvironmentMismatchError naming every difference between what the policy was trained on and
+    what ``env`` observes, takes as action, and steps at."""
+    problems = []
+    space = env.observation_space
+    spaces = getattr(space, "spaces", {})
+    env_features = getattr(env.unwrapped, "features", {})
+    for feature in checkpoint["obs_features"]:
+        name, size = feature["name"], int(feature["size"])
+        if name not in spaces:
+            problems.append(f"the environment has no observation {name!r} (it has "
+                            f"{', '.join(sorted(spaces))})")
+            continue
+        shape = tuple(spaces[name].shape or ())
+        if shape != (size,):
+            problems.append(f"observation {name!r} is {shape} in the environment, ({size},) in the "
+                            "checkpoint")
+            continue
+        env_names = getattr(env_features.get(name), "names", None)
+        if feature.get("names") and env_names and list(env_names) != list(feature["names"]):
+            problems.append(f"observation {name!r} has elements {list(env_names)[:4]}... in the "
+                            f"environment, {list(feature['names'])[:4]}... in the checkpoint (other "
+                            "objects or order)")
+    action = int(checkpoint["action_feature"]["size"])
+    if tuple(env.action_space.shape or ()) != (action,):
+        problems.append(f"the action is {env.action_space.shape} in the environment, ({action},) in the "
+                        "checkpoint")
+    fps, env_fps = int(checkpoint["dataset"]["fps"]), env.metadata.get("render_fps")
+    if env_fps is not None and int(env_fps) != fps:
+        problems.append(f"the environment steps at {env_fps} Hz, the dataset was recorded at {fps} fps")
+    if problems:
+        raise EnvironmentMismatchError(f"the checkpoint {checkpoint.get('path', '')} does not fit this "
+                                       f"environment: {'; '.join(problems)}; evaluate it in the environment "
+                                       "of the dataset it was trained on")
+
+
+def rollout(runner: PolicyRunner, env: gym.Env, seed: int | None = None) -> EpisodeResult:
+    """One episode of ``runner`` in ``env`` (reset with ``seed``, if given), to its end."""
+    runner.reset()
+    obs, info = env.reset(seed=seed)
+    steps, terminated, truncated = 0, False, False
+    while not (terminated or truncated):
+        obs, _, terminated, truncated, info = env.step(runner.act(obs))
+        steps += 1
+    return EpisodeResult(bool(info.get("success", False)), int(info.get("subtasks_done", 0)),
+                         int(info.get("subtasks", 1)), float(info.get("progress", 0.0)), steps,
+                         info.get("scene_seed"))
+
+
+def default_factory() -> EnvFactory:
+    from vcage.pipeline.evaluation import make_env
+
+    return make_env
+
+
+def evaluate(checkpoint: str | Path, episodes: int, *, seed: int = 0, max_steps: int | None = None,
+             env_config: dict[str, Any] | None = None, device: str = "cpu", threads: int | None = None,
+             make_env: EnvFactory | None = None,
+             progress: Callable[[int, int, EpisodeResult], None] | None = None) -> Evaluation:
+    """Roll out ``checkpoint`` (a file, or a training run's directory: its latest) for ``episodes``
+    episodes of the environment of ``env_config`` (default: the configuration of the dataset it was
+    trained on), seeded ``seed``; ``threads`` caps torch's CPU threads for the duration."""
+    if episodes < 1:
+        raise PolicyError(f"--episodes must be at least 1, got {episodes}")
+    torch_device(device)
+    payload = load_checkpoint(checkpoint)
+    config = env_config if env_config is not None else payload["dataset"].get("config")
+    if not config:
+        raise PolicyError(f"the dataset {payload['dataset']['path']} the checkpoint was trained on stores no "
+                          "vcage configuration (meta/vcage.json), so there is no environment to evaluate in; "
+                          "pass the environment of a vcage dataset (--env DATASET)")
+    env = (make_env or default_factory())(config, seed=seed, max_steps=max_steps)
+    old_threads = torch.get_num_threads()
+    if threads is not None:
+        torch.set_num_threads(threads)
+    try:
+        check_compatible(payload, env)
+        runner = PolicyRunner(payload, device=device, seed=seed)
+        results: list[EpisodeResult] = []
+        began = time.perf_counter()
+        for k in range(episodes):
+            results.append(rollout(runner, env, seed if k == 0 else None))
+            if progress is not None:
+                progress(k + 1, episodes, results[-1])
+        seconds = time.perf_counter() - began
+    finally:
+        env.close()
+        torch.set_num_threads(old_threads)
+    return Evaluation(str(payload["path"]), seed, tuple(results), seconds, subtask_names(config))
+
+
+def subtask_names(config: Mapping[str, Any]) -> tuple[str, ...]:
+    """The descriptions of the plan's subtasks in a dataset configuration (empty if it has no plan)."""
+    plan = config.get("plan") if isinstance(config, Mapping) else None
+    subtasks = plan.get("subtasks") if isinstance(plan, Mapping) else None
+    if not isinstance(subtasks, list):
+        return ()
+    return tuple(str(s.get("description") or s.get("skill") or f"subtask {i}") if isinstance(s, Mapping)
+                 else f"subtask {i}" for i, s in enumerate(subtasks))

@@ -1,0 +1,74 @@
+"""A trained policy acting in an environment: observation window in, one action out per step.
+
+The runner keeps the last ``n_obs_steps`` observations (the first one repeated after a reset, as
+training pads the start of an episode) and a queue of actions: when the queue is empty it predicts
+a chunk of ``horizon`` actions from the window and queues the ``n_action_steps`` starting at the
+current frame (index ``n_obs_steps - 1`` of the chunk), as Diffusion Policy executes them.
+"""
+
+from __future__ import annotations
+
+from collections import deque
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+import torch
+
+from vcage.policy.config import TrainConfig
+from vcage.policy.dataset import FeatureSpec
+from vcage.policy.errors import PolicyError
+from vcage.policy.models import Policy, make_policy
+from vcage.policy.normalize import Normalizer
+
+
+class PolicyRunner:
+    """Acts with the EMA weights of a checkpoint (as :func:`vcage.policy.checkpoint.load_checkpoint`
+    returns it); ``seed`` fixes the diffusion sampler's noise."""
+
+    def __init__(self, checkpoint: Mapping[str, Any], *, device: str = "cpu", seed: int = 0) -> None:
+        self.config = TrainConfig.from_dict(checkpoint["config"])
+        self.obs_features = tuple(FeatureSpec.from_dict(f) for f in checkpoint["obs_features"])
+        self.action_feature = FeatureSpec.from_dict(checkpoint["action_feature"])
+        self.obs_norm = Normalizer.from_dict(checkpoint["normalization"]["obs"])
+        self.action_norm = Normalizer.from_dict(checkpoint["normalization"]["action"])
+        self.device = torch.device(device)
+        obs_dim = sum(f.size for f in self.obs_features)
+        self.model: Policy = make_policy(self.config, obs_dim, self.action_feature.size)
+        try:
+            self.model.load_state_dict(checkpoint["ema"]["model"])
+        except (RuntimeError, KeyError, TypeError) as exc:
+            raise PolicyError(f"the checkpoint's weights do not fit its own configuration ({exc}); it is "
+                              "damaged: train again") from None
+        self.model.to(self.device).eval()
+        self.generator = torch.Generator().manual_seed(seed)
+        self._window: deque[np.ndarray] = deque(maxlen=self.config.n_obs_steps)
+        self._queue: deque[np.ndarray] = deque()
+
+    @property
+    def observation_keys(self) -> tuple[str, ...]:
+        return tuple(f.name for f in self.obs_features)
+
+    def reset(self) -> None:
+        """Forget the observation window and the queued actions (call at every episode start)."""
+        self._window.clear()
+        self._queue.clear()
+
+    def observation_vector(self, obs: Mapping[str, Any]) -> np.ndarray:
+        """The policy's observation features of an environment observation, side by side."""
+        return np.concatenate([np.asarray(obs[f.name], dtype=np.float32).reshape(-1)
+                               for f in self.obs_features])
+
+    def act(self, obs: Mapping[str, Any]) -> np.ndarray:
+        """The action for this step of the episode, given the environment's observation."""
+        vector = self.obs_norm.normalize(self.observation_vector(obs))
+        if not self._window:
+            self._window.extend([vector] * self.config.n_obs_steps)
+        else:
+            self._window.append(vector)
+        if not self._queue:
+            window = torch.from_numpy(np.stack(self._window)[None]).to(self.device)
+            chunk = self.model.predict(window, self.generator)[0].cpu().numpy()
+            start = self.config.n_obs_steps - 1
+            self._queue.extend(self.action_norm.unnormalize(chunk[start:start + self.config.n_action_steps]))
+        return self._queue.popleft()

@@ -1,0 +1,43 @@
+"""Normalisation from the dataset's frames: ranges, round trips, constant dimensions."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from vcage.errors import ConfigError
+from vcage.policy.normalize import Normalizer
+
+
+def frames() -> np.ndarray:
+    rng = np.random.default_rng(3)
+    x = rng.normal([1.0, -5.0, 100.0], [0.1, 3.0, 20.0], size=(200, 3))
+    x[:, 1] = 7.0  # a constant dimension
+    return x.astype(np.float32)
+
+
+def test_min_max_maps_the_frames_to_minus_one_one_and_back() -> None:
+    x = frames()
+    norm = Normalizer.fit(x, "min_max")
+    y = norm.normalize(x)
+    assert y[:, [0, 2]].min(axis=0) == pytest.approx([-1, -1], abs=1e-6)
+    assert y[:, [0, 2]].max(axis=0) == pytest.approx([1, 1], abs=1e-6)
+    assert (y[:, 1] == 0).all()  # constant: centred, not divided by zero
+    np.testing.assert_allclose(norm.unnormalize(y), x, rtol=1e-6, atol=1e-5)
+
+
+def test_mean_std_standardises_and_round_trips_through_its_stored_form() -> None:
+    x = frames()
+    norm = Normalizer.from_dict(Normalizer.fit(x, "mean_std").to_dict())
+    y = norm.normalize(x)
+    np.testing.assert_allclose(y[:, [0, 2]].mean(axis=0), 0, atol=1e-5)
+    np.testing.assert_allclose(y[:, [0, 2]].std(axis=0), 1, atol=1e-4)
+    assert np.isfinite(y).all() and (y[:, 1] == 0).all()
+    np.testing.assert_allclose(norm.unnormalize(y), x, rtol=1e-6, atol=1e-5)
+
+
+def test_unknown_modes_and_empty_frames_are_refused() -> None:
+    with pytest.raises(ConfigError, match="min_max, mean_std"):
+        Normalizer.fit(frames(), "zscore")
+    with pytest.raises(ConfigError, match="T >= 1"):
+        Normalizer.fit(np.zeros((0, 3)), "min_max")

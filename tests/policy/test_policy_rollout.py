@@ -1,0 +1,122 @@
+"""The rollout loop: observation window, action chunking, statistics of the episodes."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+import pytest
+import torch
+from gymnasium import spaces
+
+from conftest import EE, ENV, FPS, STATE, tiny
+from vcage.policy.checkpoint import load_checkpoint
+from vcage.policy.evaluate import evaluate
+from vcage.policy.inference import PolicyRunner
+from vcage.policy.metrics import subtask_reached, wilson_interval
+from vcage.policy.train import train
+
+SIZES = {STATE: 8, EE: 7, ENV: 7}
+
+
+@pytest.fixture(scope="module")
+def checkpoint(dataset: Path, tmp_path_factory: pytest.TempPathFactory) -> Path:
+    return train(dataset, tmp_path_factory.mktemp("run"), tiny("mlp", steps=4, checkpoint_every=4)).checkpoint
+
+
+class CountingEnv(gym.Env):
+    """Observations count the steps; episode k succeeds at its subtasks after 5 steps each when
+    ``k`` is in ``winners``, else is truncated after ``max_steps``."""
+
+    def __init__(self, winners: set[int], subtasks: int = 2, max_steps: int = 12) -> None:
+        self.observation_space = spaces.Dict({k: spaces.Box(-1e3, 1e3, shape=(n,)) for k, n in SIZES.items()})
+        self.action_space = spaces.Box(-10, 10, shape=(8,))
+        self.metadata = {"render_fps": FPS}
+        self.winners, self.subtasks, self.max_steps = winners, subtasks, max_steps
+        self.episode, self.resets = -1, []
+
+    def _obs(self) -> dict[str, np.ndarray]:
+        return {k: np.full(n, float(self.t), dtype=np.float32) for k, n in SIZES.items()}
+
+    def reset(self, *, seed: int | None = None, options: Any = None) -> Any:
+        self.resets.append(seed)
+        self.episode, self.t, self.done = self.episode + 1, 0, 0
+        return self._obs(), {}
+
+    def step(self, action: np.ndarray) -> Any:
+        assert action.shape == (8,) and np.isfinite(action).all()
+        self.t += 1
+        if self.episode in self.winners and self.t % 5 == 0:
+            self.done += 1
+        info = {"success": self.done == self.subtasks, "subtasks_done": self.done,
+                "subtasks": self.subtasks, "progress": self.done / self.subtasks}
+        return self._obs(), 0.0, info["success"], self.t >= self.max_steps, info
+
+
+def test_the_runner_predicts_every_eight_steps_from_a_two_frame_window(checkpoint: Path) -> None:
+    runner = PolicyRunner(load_checkpoint(checkpoint))
+    seen: list[torch.Tensor] = []
+    chunk = torch.arange(16 * 8, dtype=torch.float32).reshape(1, 16, 8) / 100
+
+    def predict(obs: torch.Tensor, generator: torch.Generator) -> torch.Tensor:
+        seen.append(obs.clone())
+        return chunk
+
+    runner.model.predict = predict  # type: ignore[method-assign]
+    env = CountingEnv(set())
+    obs, _ = env.reset()
+    actions = []
+    for _ in range(17):
+        actions.append(runner.act(obs))
+        obs, *_ = env.step(actions[-1])
+    assert len(seen) == 3  # steps 0, 8 and 16
+    first = seen[0][0]
+    assert first.shape == (2, 22) and torch.equal(first[0], first[1])  # the first frame, repeated
+    norm = runner.obs_norm
+    torch.testing.assert_close(seen[1][0], torch.from_numpy(np.stack(
+        [norm.normalize(np.full(22, 7.0)), norm.normalize(np.full(22, 8.0))])))
+    expected = runner.action_norm.unnormalize(chunk[0, 1:9].numpy())  # from the current frame on
+    np.testing.assert_allclose(np.stack(actions[:8]), expected, rtol=1e-6)
+    np.testing.assert_allclose(actions[8], expected[0], rtol=1e-6)
+    runner.reset()
+    runner.act(obs)
+    assert len(seen) == 4 and torch.equal(seen[3][0][0], seen[3][0][1])
+
+
+def test_evaluate_rolls_out_every_episode_and_counts_what_the_environment_reports(checkpoint: Path) -> None:
+    envs: list[CountingEnv] = []
+
+    def make_env(config: dict[str, Any], *, seed: int, max_steps: int | None = None) -> gym.Env:
+        envs.append(CountingEnv({0, 2}, max_steps=max_steps or 12))
+        return envs[-1]
+
+    done: list[int] = []
+    result = evaluate(checkpoint, 4, seed=3, make_env=make_env, progress=lambda k, n, r: done.append(k))
+    assert done == [1, 2, 3, 4] and envs[0].resets == [3, None, None, None]
+    assert [e.success for e in result.episodes] == [True, False, True, False]
+    assert [e.steps for e in result.episodes] == [10, 12, 10, 12]
+    assert result.success_rate == 0.5 and result.subtask_progress == [0.5, 0.5]
+    assert result.interval == pytest.approx(wilson_interval(2, 4))
+    assert result.rollouts_per_minute > 0
+    record = result.to_dict()
+    assert {"success_rate", "wilson95", "subtask_progress", "rollouts_per_minute",
+            "per_episode"} <= set(record)
+
+
+def test_wilson_intervals_and_subtask_shares() -> None:
+    assert wilson_interval(0, 2) == pytest.approx((0.0, 0.6576), abs=1e-4)
+    assert wilson_interval(5, 10) == pytest.approx((0.2366, 0.7634), abs=1e-4)
+    assert wilson_interval(10, 10) == pytest.approx((0.7225, 1.0), abs=1e-4)
+    assert wilson_interval(0, 0) == (0.0, 1.0)
+    assert subtask_reached([0, 1, 3, 2], 3) == [0.75, 0.5, 0.25]
+
+
+def test_torch_is_imported_by_neither_vcage_nor_the_cli() -> None:
+    code = "import sys, vcage, vcage.cli, vcage.policy; print('torch' in sys.modules)"
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.strip() == "False"
