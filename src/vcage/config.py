@@ -129,15 +129,29 @@ class Randomization:
         return replace(cls(), **kwargs)
 
 
+# Configs stored before ``SimConfig.noslip_iterations`` existed ran MuJoCo's no-slip solver this often.
+LEGACY_NOSLIP_ITERATIONS = 3
+_LEGACY_SIM_FIELDS = ("timestep", "control_hz", "max_qvel")  # what SimConfig held then
+
+
 @dataclass(frozen=True)
 class SimConfig:
-    """Physics and control rates."""
+    """Physics and control rates.
+
+    ``noslip_iterations`` are MuJoCo's no-slip solver passes after each step. Off by default: in the
+    plan scenes with clutter they cost most of a step (the solver needs the dense constraint matrix)
+    and changed no scene check and no scripted outcome (``benchmarks/physics_settings.py``).
+    """
 
     timestep: float = 0.002
     control_hz: float = 20.0
     max_qvel: float = 100.0  # rad/s or m/s; above this the simulation is declared unstable
+    noslip_iterations: int = 0
 
     def __post_init__(self) -> None:
+        noslip = self.noslip_iterations
+        if isinstance(noslip, bool) or not isinstance(noslip, int) or noslip < 0:
+            raise ConfigError(f"noslip_iterations must be an integer >= 0, got {noslip!r}")
         if not 1e-4 <= self.timestep <= 0.01:
             raise ConfigError(f"timestep {self.timestep} s must lie in [1e-4, 0.01]")
         if self.control_hz <= 0:
@@ -158,6 +172,12 @@ class SimConfig:
 
     @classmethod
     def from_dict(cls, data: dict[str, Any]) -> SimConfig:
+        """Read a config. A complete one stored before ``noslip_iterations`` existed (every other
+        field, not that one) ran with :data:`LEGACY_NOSLIP_ITERATIONS` and gets them back, so its
+        runs reproduce; a partial one gets the defaults."""
+        legacy = isinstance(data, dict) and set(_LEGACY_SIM_FIELDS) <= set(data)
+        if legacy and "noslip_iterations" not in data:
+            data = {**data, "noslip_iterations": LEGACY_NOSLIP_ITERATIONS}
         return from_fields(cls, data)
 
 

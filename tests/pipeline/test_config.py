@@ -90,3 +90,19 @@ def test_endpoints_are_resolved_from_the_environment_once(monkeypatch: pytest.Mo
     with pytest.raises(ConfigError, match="VCAGE_LLM_MODEL"):
         GenerateConfig(planner=PlannerConfig("llm")).resolved()
     assert GenerateConfig().resolved() == GenerateConfig()  # offline defaults need nothing
+
+
+def test_noslip_is_off_by_default_and_an_older_stored_config_keeps_its_three_passes() -> None:
+    from vcage.config import SimConfig
+    from vcage.scene.compose import compose
+    from vcage.scene.spec import SceneSpec
+
+    assert SimConfig().noslip_iterations == 0
+    older = {"timestep": 0.002, "control_hz": 20.0, "max_qvel": 100.0}  # stored before the field existed
+    assert SimConfig.from_dict(older).noslip_iterations == 3
+    assert SimConfig.from_dict({"timestep": 0.002}).noslip_iterations == 0  # partial: the defaults
+    assert SimConfig.from_dict({**older, "noslip_iterations": 1}).noslip_iterations == 1
+    with pytest.raises(ConfigError, match="noslip_iterations"):
+        SimConfig(noslip_iterations=-1)
+    for passes in (0, 3):
+        assert compose(SceneSpec(), SimConfig(noslip_iterations=passes)).model.opt.noslip_iterations == passes

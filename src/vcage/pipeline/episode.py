@@ -8,18 +8,20 @@ critic rejected a subtask, or it was accepted.
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 
 import numpy as np
 
 from vcage.critics.base import Critic
 from vcage.errors import PlacementError, SimulationError
 from vcage.pipeline.config import GenerateConfig
+from vcage.pipeline.critic_views import sheet_png
 from vcage.pipeline.plan_layout import plan_layout
 from vcage.pipeline.rollout import Rollout, run_plan
 from vcage.pipeline.stage import Stage
 from vcage.pipeline.verifier import Verifier
 from vcage.planning.schema import Plan
+from vcage.scene.compose import compose
 from vcage.scene.instantiate import Instantiator, SceneInstance
 from vcage.scene.spec import SceneSpec
 from vcage.sim.render import Renderer
@@ -28,19 +30,46 @@ from vcage.skills.base import Skills
 from vcage.skills.playback import Player, Recording
 from vcage.skills.reachability import reach_map
 
+# Where a run's time goes, phase by phase, in the order an episode meets them. An attempt fills
+# placement .. critic_judge; the driver adds planning (once per run) and what an accepted episode
+# costs after acceptance: video rendering, the per-frame features, video encoding and writing.
+PHASES = ("planning", "placement", "compose", "scene_check", "physics", "critic_views", "critic_judge",
+          "video_render", "features", "encoding", "writing")
+
 
 @dataclass
 class Timing:
-    """Wall time by activity, to relate the total to physics and rendering."""
+    """Wall time (seconds) by phase, measured where each happens, and the total.
 
+    ``physics`` is the robot's control steps (``mj_step`` while acting); the settling of the scene
+    check is part of ``scene_check``, compiling the scene is ``compose``. ``total`` is an attempt's
+    wall time (for a run: the attempts' sum). Timings never enter the dataset's data files.
+    """
+
+    planning: float = 0.0
+    placement: float = 0.0
+    compose: float = 0.0
+    scene_check: float = 0.0
     physics: float = 0.0
-    render: float = 0.0
+    critic_views: float = 0.0
+    critic_judge: float = 0.0
+    video_render: float = 0.0
+    features: float = 0.0
+    encoding: float = 0.0
+    writing: float = 0.0
     total: float = 0.0
 
+    @property
+    def render(self) -> float:
+        """All rendering: the critic's views and the videos."""
+        return self.critic_views + self.video_render
+
+    def phases(self) -> dict[str, float]:
+        return {name: getattr(self, name) for name in PHASES}
+
     def add(self, other: Timing) -> None:
-        self.physics += other.physics
-        self.render += other.render
-        self.total += other.total
+        for f in fields(self):
+            setattr(self, f.name, getattr(self, f.name) + getattr(other, f.name))
 
 
 @dataclass
@@ -54,6 +83,7 @@ class Attempt:
     world: World | None = None
     initial_state: np.ndarray | None = None
     timing: Timing = field(default_factory=Timing)
+    critic_view: bytes | None = None  # PNG of the views the critic rejected (:mod:`.critic_views`)
 
     @property
     def accepted(self) -> bool:
@@ -75,6 +105,8 @@ def attempt(plan: Plan, seed: int, cfg: GenerateConfig, critic: Critic | None) -
 
 
 def _attempt(plan: Plan, seed: int, cfg: GenerateConfig, critic: Critic | None, timing: Timing) -> Attempt:
+    clock = time.perf_counter
+    t0 = clock()
     rng = np.random.default_rng(seed)
     layout = plan_layout(plan, rng, cfg.randomization, cfg.scene.clutter)
     instantiator = Instantiator(cfg.scene, cfg.sim, reach_map())
@@ -82,14 +114,26 @@ def _attempt(plan: Plan, seed: int, cfg: GenerateConfig, critic: Critic | None, 
         spec, stats = instantiator.place(layout, rng)
     except PlacementError as exc:
         return Attempt(seed, Stage.PLACEMENT, str(exc))
+    finally:
+        timing.placement += clock() - t0
+    t0 = clock()
     try:
-        instance = instantiator.realize(spec, stats)
+        # Compiled here into compose's model cache, which realize() then finds: the compile and the
+        # scene check (settling, stability) are timed apart. The model is the same either way.
+        compose(spec, cfg.sim)
+        t1 = clock()
+        timing.compose += t1 - t0
+        try:
+            instance = instantiator.realize(spec, stats)
+        finally:
+            timing.scene_check += clock() - t1
     except SimulationError as exc:
         return Attempt(seed, Stage.PHYSICS, str(exc), spec)
+    settled = instance.world.physics_seconds
     try:
         return _execute(plan, seed, cfg, critic, timing, instance)
     finally:
-        timing.physics += instance.world.physics_seconds
+        timing.physics += instance.world.physics_seconds - settled
 
 
 def _execute(plan: Plan, seed: int, cfg: GenerateConfig, critic: Critic | None, timing: Timing,
@@ -101,15 +145,20 @@ def _execute(plan: Plan, seed: int, cfg: GenerateConfig, critic: Critic | None, 
     try:
         initial = world.get_state()
         skills = Skills(world, Player(world, record_states=True))
-        renderer = (Renderer(world, *cfg.render.critic_size)
+        t0 = time.perf_counter()
+        renderer = (Renderer(world, *cfg.render.critic_size, cfg.render.mesh_detail)
                     if critic is not None and critic.needs_views else None)
+        timing.critic_views += time.perf_counter() - t0
+        verifier = None
         try:
             verifier = (Verifier(world, plan, critic, renderer, skills.player.recording, timing)
                         if critic is not None else None)
             rollout = run_plan(world, plan, skills, verifier)
         finally:
             if renderer is not None:
+                t0 = time.perf_counter()
                 renderer.close()
+                timing.critic_views += time.perf_counter() - t0
     except SimulationError as exc:
         return Attempt(seed, Stage.PHYSICS, str(exc), scene)
     out = Attempt(seed, Stage.ACCEPTED, "", scene, rollout, skills.player.recording, world, initial)
@@ -120,4 +169,5 @@ def _execute(plan: Plan, seed: int, cfg: GenerateConfig, critic: Critic | None, 
         else:
             verdict = last.verdict or {}
             out.stage, out.reason = Stage.CRITIC, f"subtask {last.index + 1}: {verdict.get('reason', '')}"
+            out.critic_view = sheet_png(verifier.rejected_views) if verifier is not None else None
     return out

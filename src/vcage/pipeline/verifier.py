@@ -32,7 +32,10 @@ class Outcome(Protocol):
 
 
 class Timed(Protocol):
-    render: float
+    """Where the verifier adds its seconds (see :class:`.episode.Timing`)."""
+
+    critic_views: float  # rendering the views (and setting the state of the "during" frame)
+    critic_judge: float  # the critic's judgement of them
 
 
 def render_views(renderer: Renderer, cameras: tuple[str, ...] = CRITIC_CAMERAS,
@@ -54,21 +57,23 @@ class Verifier:
         self.rejected_views: dict[str, dict[str, View]] = {}  # moment -> views of a rejected subtask
 
     def _views(self) -> dict[str, View]:
-        if self.renderer is None:
-            return {}
-        t0 = time.perf_counter()
-        views = render_views(self.renderer)
-        self.timing.render += time.perf_counter() - t0
-        return views
+        return render_views(self.renderer) if self.renderer is not None else {}
 
     def start(self, index: int, subtask: Subtask) -> None:
+        t0 = time.perf_counter()
         self._before = self._views()
+        self.timing.critic_views += time.perf_counter() - t0
 
     def judge(self, outcome: Outcome) -> dict[str, Any]:
+        t0 = time.perf_counter()
+        after = self._views()
+        during = self._deepest(outcome)
+        t1 = time.perf_counter()
+        self.timing.critic_views += t1 - t0
         obs = Observation(subtask=self.plan.subtasks[outcome.index], labels=tuple(self.world.object_names),
-                          before=self._before, after=self._views(), during=self._deepest(outcome),
-                          oracle=outcome.oracle)
+                          before=self._before, after=after, during=during, oracle=outcome.oracle)
         verdict = self.critic.judge(obs)
+        self.timing.critic_judge += time.perf_counter() - t1
         if not verdict.accept:
             self.rejected_views = {"before": obs.before, "during": obs.during, "after": obs.after}
         return verdict.to_dict()

@@ -47,7 +47,7 @@ def _base_spec(sim: SimConfig) -> mujoco.MjSpec:
     spec.modelname = "vcage_scene"
     spec.option.timestep = sim.timestep
     spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
-    spec.option.noslip_iterations = 3
+    spec.option.noslip_iterations = sim.noslip_iterations
     spec.option.cone = mujoco.mjtCone.mjCONE_ELLIPTIC
     spec.option.impratio = 10
     vis = spec.visual
