@@ -15,8 +15,8 @@ from vcage.cli.errors import MARKER, cli_errors
 from vcage.errors import ConfigError
 
 RUN = CliRunner()
-VERBS = ["tasks", "plan", "generate", "inspect", "audit", "verify", "export", "catalog", "scene", "run",
-         "demo"]
+VERBS = ["tasks", "plan", "generate", "inspect", "audit", "report", "verify", "backfill", "export", "catalog",
+         "scene", "run", "demo", "synthesize", "train", "evaluate"]
 
 
 def test_every_command_is_registered_in_order_and_wrapped() -> None:

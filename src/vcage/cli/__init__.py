@@ -10,8 +10,10 @@ from vcage.cli._app import app, console
 
 # The order of these imports is the order of the commands in `vcage --help`.
 # isort: off
-from vcage.cli import tasks, plan, generate, inspect_cmd, audit, verify  # noqa: F401
-from vcage.cli import export, catalog, scene, run  # noqa: F401
+from vcage.cli import tasks, plan, generate, inspect_cmd, audit, report, verify  # noqa: F401
+from vcage.cli import backfill, export, catalog, scene, run  # noqa: F401
+from vcage.cli import synthesize  # noqa: F401
+from vcage.cli import train, evaluate  # noqa: F401
 # isort: on
 
 

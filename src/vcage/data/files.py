@@ -18,7 +18,7 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 
 from vcage.data import stats as st
-from vcage.data.layout import PROVENANCE
+from vcage.data.layout import INFO_PATH, PROVENANCE
 from vcage.errors import DatasetError
 
 TMP_MARK = ".tmp-"  # temporary files are named .<name>.tmp-<pid>-<random>
@@ -92,6 +92,16 @@ def settle_backups(root: Path, committed: int) -> list[Path]:
         else:
             backup.unlink()
     return restored
+
+
+def settle_interrupted(root: Path) -> list[Path]:
+    """:func:`settle_backups` against the count ``meta/info.json`` commits; nothing when it cannot be
+    read (the integrity checks report that)."""
+    try:
+        committed = int(json.loads((root / INFO_PATH).read_text())["total_episodes"])
+    except (OSError, ValueError, KeyError, TypeError):
+        return []
+    return settle_backups(root, committed)
 
 
 def restore_backup(backup: Path, original: Path) -> None:

@@ -21,6 +21,7 @@ import functools
 import io
 import json
 import os
+import time
 from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Any, cast
@@ -44,7 +45,7 @@ from vcage.data.files import (
     remove_empty_dirs,
     restore_backup,
     scratch,
-    settle_backups,
+    settle_interrupted,
     tasks_table,
     to_json,
     write_json,
@@ -185,8 +186,7 @@ class DatasetWriter:
         if not (self.root / layout.VCAGE_PATH).is_file() or not (self.root / layout.INFO_PATH).is_file():
             raise DatasetError(f"{self.root} is not empty and holds no vcage dataset (no {layout.VCAGE_PATH} "
                                f"and {layout.INFO_PATH}); choose another --out directory or an empty one")
-        with contextlib.suppress(Exception):  # a damaged info.json is the check's to report
-            settle_backups(self.root, int(load_json(self.root / layout.INFO_PATH)["total_episodes"]))
+        settle_interrupted(self.root)  # an interrupted episode's replaced files: the committed bytes
         report = check(self.root)
         if not report.ok:
             raise CorruptDatasetError(f"refusing to append to the damaged dataset {self.root}: "
@@ -390,8 +390,11 @@ class DatasetWriter:
 
     def add_episode(self, frames: Mapping[str, Any], videos: Mapping[str, Any] | None = None, *, task: str,
                     extras: Mapping[str, Any] | None = None,
-                    arrays: Mapping[str, np.ndarray] | None = None) -> int:
-        """Write one episode and commit it; returns its index. Nothing is kept if anything fails."""
+                    arrays: Mapping[str, np.ndarray] | None = None,
+                    timings: dict[str, float] | None = None) -> int:
+        """Write one episode and commit it; returns its index. Nothing is kept if anything fails.
+
+        ``timings``, if given, gets the seconds spent encoding videos added under ``"encode"``."""
         if not isinstance(task, str) or not task.strip():
             raise DatasetError(f"task must be a non-empty string, got {task!r}")
         checked = self._validate(frames, videos or {})
@@ -410,7 +413,7 @@ class DatasetWriter:
         position, video_start = (0, 0), 0
         try:
             position, joined = self._write_files(index, table, checked, extras_json if extras else None,
-                                                 states, files)
+                                                 states, files, timings)
             video_start = self._file_frames if joined else 0
             row = episode_row(index, task, length, self._total_frames, position=position,
                               video_start=video_start, chunks_size=self.chunks_size, fps=self.fps,
@@ -459,7 +462,8 @@ class DatasetWriter:
         return self.root / layout.VIDEO_PATH.format(video_key=key, chunk_index=chunk, file_index=file)
 
     def _write_files(self, index: int, table: pa.Table, checked: dict[str, np.ndarray], extras: Any,
-                     states: dict[str, np.ndarray], files: _EpisodeFiles) -> tuple[tuple[int, int], bool]:
+                     states: dict[str, np.ndarray], files: _EpisodeFiles,
+                     timings: dict[str, float] | None = None) -> tuple[tuple[int, int], bool]:
         """Data rows, one video per camera (joined to the open files or starting the next), extras
         json and arrays npz; ``files`` records what was created or replaced. Returns the position
         of the episode's data and video files and whether it joined the open ones."""
@@ -471,7 +475,10 @@ class DatasetWriter:
             scratch_dir = self.root / "videos" / key
             scratch_dir.mkdir(parents=True, exist_ok=True)
             tmp = files.scratch(scratch(scratch_dir / "episode.mp4"))
+            t0 = time.perf_counter()
             video.encode_video(tmp, checked[key], fps=self.fps, encoder=self._encoder)
+            if timings is not None:
+                timings["encode"] = timings.get("encode", 0.0) + time.perf_counter() - t0
             encoded[key] = tmp
         joined = self._joins({"data": data.size, **{k: p.stat().st_size for k, p in encoded.items()}})
         assert self._position is not None or not joined
@@ -480,8 +487,7 @@ class DatasetWriter:
         committed = self._total_episodes
         path = self._file("data", position)
         if joined:
-            files.replace(path, committed, lambda tmp: pq.write_table(
-                pa.concat_tables([read_parquet(path), table]), tmp))
+            files.replace(path, committed, functools.partial(_append_rows, path, table))
         else:
             files.create(path, lambda tmp: tmp.write_bytes(data.to_pybytes()))
         for key, tmp_video in encoded.items():
@@ -573,6 +579,16 @@ class _EpisodeFiles:
         for path, backup in self.backups:
             with contextlib.suppress(OSError):
                 restore_backup(backup, path)
+
+
+def _append_rows(path: Path, table: pa.Table, out: Path) -> None:
+    """Write the rows of the parquet ``path`` and then ``table`` to ``out`` (columns in the order of
+    the file's, which a dataset given features later, e.g. by back-filling, may have changed)."""
+    old = read_parquet(path)
+    if set(old.column_names) != set(table.column_names):
+        raise DatasetError(f"{path} has the columns {sorted(old.column_names)}, the episode "
+                           f"{sorted(table.column_names)}")
+    pq.write_table(pa.concat_tables([old, table.select(old.column_names)]), out)
 
 
 def _number(value: float) -> int | float:

@@ -29,7 +29,7 @@ from vcage.data.files import (
     episodes_table,
     lock_dir,
     remove_empty_dirs,
-    settle_backups,
+    settle_interrupted,
     tasks_table,
     write_json,
     write_table,
@@ -104,8 +104,7 @@ def repair(root: str | Path) -> RepairReport:
         raise DatasetError(f"{root} is not a directory; give a dataset directory")
     fd = lock_dir(root)
     try:
-        with contextlib.suppress(Exception):  # an interrupted write's replaced files: the committed bytes
-            settle_backups(root, int(load_json(root / layout.INFO_PATH)["total_episodes"]))
+        settle_interrupted(root)  # an interrupted write's replaced files: the committed bytes
         scan = Scan(root, decode=True).run()
         before = scan.report()
         if before.ok:

@@ -24,11 +24,12 @@ from typing import Any
 from vcage.data import DatasetReader, DatasetWriter
 from vcage.data.layout import ATTEMPTS_LOG, RUNS_LOG
 from vcage.errors import ConfigError
-from vcage.pipeline import attempt_log
+from vcage.pipeline import attempt_log, critic_views
 from vcage.pipeline.config import GenerateConfig
 from vcage.pipeline.episode import Timing
 from vcage.pipeline.executors import make_executor
-from vcage.pipeline.sampling import FEATURES, EpisodeRun, build_critic, camera_key
+from vcage.pipeline.features import dataset_features
+from vcage.pipeline.sampling import EpisodeRun, build_critic, camera_key
 from vcage.pipeline.stage import Stage
 from vcage.planning import make_planner
 from vcage.planning.schema import Plan
@@ -66,8 +67,11 @@ class Funnel:
             "accepted_oracle_failed": self.accepted_oracle_failed, "label_noise": self.label_noise,
             "wall_seconds": round(self.wall, 2), "workers": self.workers,
             "core_seconds": round(core_seconds, 2),
+            # physics: the robot's control steps; render: critic views + videos; attempts_total:
+            # the attempts' wall time; then every phase of :data:`.episode.PHASES` (physics again)
             "seconds": {"physics": round(self.timing.physics, 2), "render": round(self.timing.render, 2),
-                        "attempts_total": round(self.timing.total, 2)},
+                        "attempts_total": round(self.timing.total, 2),
+                        **{name: round(value, 3) for name, value in self.timing.phases().items()}},
             "episodes_per_hour": self.accepted / hours if hours > 0 else 0.0,
             "episodes_per_core_hour": self.accepted / (core_seconds / 3600) if core_seconds > 0 else 0.0,
             # core time (idle workers included) over the time spent in physics and rendering
@@ -95,12 +99,14 @@ def generate(instruction: str, episodes: int, out: Path | str, cfg: GenerateConf
     pool = make_executor(cfg.executor)  # checks the arguments before any work
     t0 = time.perf_counter()
     plan = plan or make_planner(cfg.planner).plan(instruction)
+    planning = time.perf_counter() - t0
     critic = build_critic(cfg)  # a misconfigured critic (e.g. no API key) fails here, before any work
     if critic is not None:
         critic.preflight()  # an unreachable endpoint or unserved model, before any simulation
     width, height = cfg.render.size
     funnel = Funnel(workers=cfg.executor.workers)
-    with DatasetWriter(out, fps=int(cfg.sim.control_hz), features=FEATURES,
+    funnel.timing.planning = planning
+    with DatasetWriter(out, fps=int(cfg.sim.control_hz), features=dataset_features(plan),
                        cameras={camera_key(c): (height, width) for c in cfg.render.cameras},
                        robot_type="franka_panda",
                        config={"generate": cfg.data_dict(), "plan": plan.model_dump(mode="json")}) as writer:
@@ -133,25 +139,36 @@ class _Log:
             committed = [reader.extras(i) for i in range(reader.num_episodes)]
         self.next_sample = attempt_log.reconcile(self.path, committed)
         self.pending: list[dict[str, Any]] = []
+        self.views: dict[tuple[int, int], bytes] = {}
 
-    def add(self, records: list[dict[str, Any]]) -> None:
+    def add(self, records: list[dict[str, Any]], views: dict[tuple[int, int], bytes]) -> None:
+        """Log ``records``, with the critic's views of the rejected ones (stored first)."""
         self.pending += records
+        self.views.update(views)
         if self.writer.num_episodes:
+            critic_views.write(self.writer.root, self.views)
             attempt_log.append(self.path, self.pending)
-            self.pending = []
+            self.pending, self.views = [], {}
 
 
 def _record(writer: DatasetWriter, log: _Log, plan: Plan, run: EpisodeRun, funnel: Funnel) -> None:
     """Count the run's attempts in the funnel, commit its episode if it has one, then log them."""
     for record, timing in zip(run.records, run.timings, strict=True):
         _count(funnel, record, timing)
-    funnel.timing.render += run.video_seconds
+    funnel.timing.video_render += run.video_render
+    funnel.timing.features += max(0.0, run.video_seconds - run.video_render)
     if run.episode is None:
         funnel.given_up += 1
     else:
         ep = run.episode
-        writer.add_episode(ep.frames, ep.videos, task=plan.instruction, extras=ep.extras, arrays=ep.arrays)
-    log.add(run.records)
+        seconds: dict[str, float] = {}
+        t0 = time.perf_counter()
+        writer.add_episode(ep.frames, ep.videos, task=plan.instruction, extras=ep.extras, arrays=ep.arrays,
+                           timings=seconds)
+        encoding = seconds.get("encode", 0.0)
+        funnel.timing.encoding += encoding
+        funnel.timing.writing += max(0.0, time.perf_counter() - t0 - encoding)
+    log.add(run.records, run.critic_views)
 
 
 def _count(funnel: Funnel, record: dict[str, Any], timing: Timing) -> None:

@@ -15,18 +15,11 @@ from typing import Any
 import numpy as np
 
 from vcage.critics import Critic, make_critic
-from vcage.data import Feature
 from vcage.pipeline.config import GenerateConfig
 from vcage.pipeline.episode import Attempt, Timing, attempt
+from vcage.pipeline.features import environment_states, frames_of, subtask_indices
 from vcage.planning.schema import Plan
 from vcage.sim.render import Renderer
-
-JOINTS = [f"joint{i}" for i in range(1, 8)]
-FEATURES = {
-    "observation.state": Feature("float32", (8,), names=[*JOINTS, "gripper_width"]),
-    "observation.ee_pose": Feature("float32", (7,), names=["x", "y", "z", "qw", "qx", "qy", "qz"]),
-    "action": Feature("float32", (8,), names=[*JOINTS, "gripper"]),
-}
 
 
 def camera_key(camera: str) -> str:
@@ -45,14 +38,17 @@ class EpisodeData:
 
 @dataclass
 class EpisodeRun:
-    """What one episode's attempts produced: a log record and timing per attempt, and the episode
-    if one was accepted (with the time its videos took to render)."""
+    """What one episode's attempts produced: a log record and timing per attempt, the episode
+    if one was accepted (with the time its videos took to render), and what the critic saw in each
+    attempt it rejected."""
 
     index: int
     records: list[dict[str, Any]] = field(default_factory=list)
     timings: list[Timing] = field(default_factory=list)
     episode: EpisodeData | None = None
-    video_seconds: float = 0.0
+    video_seconds: float = 0.0  # making the accepted episode's data: videos, features, extras
+    video_render: float = 0.0  # ... of which rendering the videos
+    critic_views: dict[tuple[int, int], bytes] = field(default_factory=dict)  # (sample, attempt) -> PNG
 
 
 def sample_episode(plan: Plan, index: int, cfg: GenerateConfig, critic: Critic | None) -> EpisodeRun:
@@ -62,10 +58,13 @@ def sample_episode(plan: Plan, index: int, cfg: GenerateConfig, critic: Critic |
         result = attempt(plan, cfg.episode_seed(index, j), cfg, critic)
         run.records.append(log_record(index, j, result))
         run.timings.append(result.timing)
+        if result.critic_view is not None:
+            run.critic_views[(index, j)] = result.critic_view
         if result.accepted:
-            t0 = time.perf_counter()
-            run.episode = episode_data(plan, cfg, result, run.records)
+            t0, made = time.perf_counter(), Timing()
+            run.episode = episode_data(plan, cfg, result, run.records, made)
             run.video_seconds = time.perf_counter() - t0
+            run.video_render = made.video_render
             break
     return run
 
@@ -92,18 +91,17 @@ def log_record(episode: int, index: int, result: Attempt) -> dict[str, Any]:
 
 
 def episode_data(plan: Plan, cfg: GenerateConfig, result: Attempt,
-                 attempts: list[dict[str, Any]]) -> EpisodeData:
+                 attempts: list[dict[str, Any]], timing: Timing | None = None) -> EpisodeData:
     """What the writer needs for the accepted attempt, the last of ``attempts`` (the log records of
     this episode's attempts): features, videos, extras, states. The extras carry the records, so
-    the attempt log can be restored from the dataset (:mod:`.attempt_log`)."""
+    the attempt log can be restored from the dataset (:mod:`.attempt_log`). ``timing``, if given,
+    gets the seconds the videos took to render added to its ``video_render``."""
     assert result.recording is not None and result.world is not None and result.rollout is not None
     rec = result.recording.arrays()
-    frames = {
-        "observation.state": np.column_stack([rec["qpos"], rec["gripper"]]).astype(np.float32),
-        "observation.ee_pose": np.column_stack([rec["ee_pos"], rec["ee_quat"]]).astype(np.float32),
-        "action": rec["action"].astype(np.float32),
-    }
     states = np.asarray(result.recording.states)
+    bounds = [(o.start, o.end) for o in result.rollout.outcomes]
+    frames = frames_of(rec, environment_states(result.world, plan, states),
+                       subtask_indices(bounds, len(states)))
     extras = {
         "seed": result.seed, "attempt": attempts[-1]["attempt"], "sample": attempts[-1]["episode"],
         "instruction": plan.instruction,
@@ -115,18 +113,15 @@ def episode_data(plan: Plan, cfg: GenerateConfig, result: Attempt,
         "attempts": list(attempts),
     }
     arrays = {"states": states, "initial_state": np.asarray(result.initial_state)}
-    return EpisodeData(frames, _render_videos(result, states, cfg), extras, arrays)
+    t0 = time.perf_counter()
+    videos = _render_videos(result, states, cfg)
+    if timing is not None:
+        timing.video_render += time.perf_counter() - t0
+    return EpisodeData(frames, videos, extras, arrays)
 
 
 def _render_videos(result: Attempt, states: np.ndarray, cfg: GenerateConfig) -> dict[str, np.ndarray]:
-    world = result.world
-    assert world is not None
-    width, height = cfg.render.size
-    cameras = cfg.render.cameras
-    out = {camera_key(c): np.empty((len(states), height, width, 3), np.uint8) for c in cameras}
-    with Renderer(world, width, height) as renderer:
-        for i, state in enumerate(states):
-            world.set_state(state)
-            for cam in cameras:
-                out[camera_key(cam)][i] = renderer.rgb(cam)
-    return out
+    assert result.world is not None
+    with Renderer(result.world, *cfg.render.size, cfg.render.mesh_detail) as renderer:
+        frames = renderer.rgb_states(states, cfg.render.cameras)
+    return {camera_key(c): frames[c] for c in cfg.render.cameras}

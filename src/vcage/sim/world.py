@@ -45,6 +45,7 @@ class World:
         self.robot = Robot(model)
         self.substeps = sim.substeps
         self.physics_seconds = 0.0  # wall time spent in step(), to relate a run's total to physics
+        self._scratch: mujoco.MjData | None = None  # kinematics off the simulation (object_poses)
         self._root_to_object = np.full(model.nbody, -1, dtype=np.int32)
         self.object_names = list(objects)
         for idx, inst in enumerate(objects.values()):
@@ -125,6 +126,17 @@ class World:
         mujoco.mj_setState(self.model, self.data, np.asarray(state, dtype=float), STATE_SPEC)
         self.forward()
 
+    def show_state(self, state: np.ndarray) -> None:
+        """Set ``state`` and compute only what drawing it needs: the poses of bodies, geoms, sites,
+        cameras and lights, and tendon paths; not contacts, forces or sensors (use
+        :meth:`set_state` before reading those; a step recomputes everything)."""
+        mujoco.mj_setState(self.model, self.data, np.asarray(state, dtype=float), STATE_SPEC)
+        mujoco.mj_kinematics(self.model, self.data)
+        mujoco.mj_comPos(self.model, self.data)
+        mujoco.mj_camlight(self.model, self.data)
+        if self.model.ntendon:
+            mujoco.mj_tendon(self.model, self.data)
+
     # -- object queries ----------------------------------------------------------------------
     def object(self, name: str) -> ObjectInstance:
         try:
@@ -133,6 +145,27 @@ class World:
             from vcage.errors import SceneError
 
             raise SceneError(f"no object {name!r} in the scene; objects: {sorted(self.objects)}") from None
+
+    def object_poses(self, names: list[str] | tuple[str, ...], state: np.ndarray | None = None) -> np.ndarray:
+        """(len(names), 7) poses of the objects' root bodies: position and quaternion (w, x, y, z)
+        with ``w >= 0``, from the kinematics of ``state`` (default: the current ``qpos``).
+
+        Computed in a scratch copy of the data, so the simulation is not touched: after
+        :meth:`step` the world's own body poses lag its ``qpos`` by the step (MuJoCo computes them
+        before integrating); these never do.
+        """
+        ids = [self.object(n).body_id for n in names]
+        if self._scratch is None:
+            self._scratch = mujoco.MjData(self.model)
+        scratch = self._scratch
+        if state is None:
+            scratch.qpos[:] = self.data.qpos
+        else:
+            mujoco.mj_setState(self.model, scratch, np.asarray(state, dtype=float), STATE_SPEC)
+        mujoco.mj_kinematics(self.model, scratch)
+        quat = scratch.xquat[ids].copy()
+        quat[quat[:, 0] < 0] *= -1.0
+        return np.column_stack([scratch.xpos[ids], quat])
 
     def object_pos(self, name: str) -> np.ndarray:
         return self.data.xpos[self.object(name).body_id].copy()

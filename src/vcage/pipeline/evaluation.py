@@ -1,0 +1,214 @@
+"""Evaluation environments for a dataset's plan: the scenes generation samples, on seeds no
+training episode can have, with success and per-subtask progress from the oracle.
+
+:func:`make_env` builds one from the configuration a dataset stores (``meta/vcage.json``, read as
+``DatasetReader(root).config``): the same plan, scene sampler (placement, clutter, domain
+randomisation) and simulator settings as the generation run that made the dataset.
+
+* **Seeds.** Episode ``k`` of an environment seeded ``s`` places its scene with the seed
+  ``2**32 + SeedSequence([s, k, j])`` for the first try ``j`` whose scene places and settles.
+  Generation's attempt seeds are below ``2**32`` (:meth:`GenerateConfig.episode_seed`), so no
+  evaluation scene is a training scene, for any dataset. ``reset(options={"scene_seed": seed})``
+  builds the scene of a given seed instead (an audit: a training episode's seed gives its scene,
+  and replaying its actions reproduces its frames).
+* **Observations** are the dataset's feature vectors (:mod:`vcage.pipeline.features`):
+  ``observation.state``, ``observation.ee_pose``, ``observation.environment_state``, read as the
+  recording reads them during generation.
+* **Actions** are the dataset's ``action``: 7 absolute arm joint targets and a gripper command in
+  [0, 1], held for one control period (1 / ``control_hz``).
+* **Success** follows the plan: the subtasks are checked in order, each by the oracle as generation
+  checks it (every predicate true on ``HOLD_STEPS`` consecutive control steps; events latched while
+  the subtask is the current one). ``info``: ``success``, ``subtasks_done``, ``subtasks``,
+  ``progress`` (done / subtasks) and ``scene_seed``. Reward 1 on the step the last subtask
+  completes; ``terminated`` then; ``truncated`` after ``max_steps`` steps.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any, ClassVar
+
+import gymnasium as gym
+import numpy as np
+from gymnasium import spaces
+from gymnasium.error import ResetNeeded
+
+from vcage.errors import ConfigError, PlacementError, SceneError, SimulationError
+from vcage.pipeline.config import GenerateConfig
+from vcage.pipeline.features import EE_POSE, ENVIRONMENT, STATE, dataset_features, observe
+from vcage.pipeline.plan_layout import plan_layout
+from vcage.planning.schema import Plan
+from vcage.scene.instantiate import Instantiator
+from vcage.sim.render import Renderer
+from vcage.sim.robot import GRIPPER_OPEN
+from vcage.sim.world import World
+from vcage.skills.reachability import reach_map
+from vcage.tasks.oracle import Oracle
+from vcage.tasks.success import HOLD_STEPS
+
+EVAL_SEED_BASE = 2**32  # generation's attempt seeds are below: evaluation scenes are never training scenes
+STEPS_PER_SUBTASK = 600  # default episode length: 30 s per subtask at 20 Hz (experts take 5-15 s)
+POS_LIMIT = 5.0  # metres: bound of every observed position (the scene spans about 2 m)
+
+
+def eval_seed(base: int, episode: int, attempt: int) -> int:
+    """The scene seed of try ``attempt`` of evaluation episode ``episode`` of an env seeded ``base``."""
+    return EVAL_SEED_BASE + int(np.random.SeedSequence([base, episode, attempt]).generate_state(1)[0])
+
+
+def make_env(config: dict[str, Any], *, seed: int = 0, max_steps: int | None = None,
+             render_mode: str | None = None, scenes: Sequence[int] | None = None) -> GoalEnv:
+    """The evaluation environment of a dataset made with ``config`` (its ``meta/vcage.json``
+    configuration: ``{"generate": ..., "plan": ...}``); ``scenes``: see :class:`GoalEnv`."""
+    if not isinstance(config, dict) or not isinstance(config.get("generate"), dict) \
+            or not isinstance(config.get("plan"), dict):
+        raise ConfigError("an evaluation environment needs the configuration a vcage dataset stores "
+                          "(meta/vcage.json: 'generate' and 'plan'); this one has neither")
+    return GoalEnv(Plan.model_validate(config["plan"]), GenerateConfig.from_dict(config["generate"]),
+                   seed=seed, max_steps=max_steps, render_mode=render_mode, scenes=scenes)
+
+
+class GoalEnv(gym.Env[dict[str, np.ndarray], np.ndarray]):
+    """The plan ``plan`` in scenes sampled as ``cfg`` samples them, as a Gymnasium environment.
+
+    ``reset()`` without a seed moves to the next evaluation episode; ``reset(seed=s)`` starts the
+    episode sequence of seed ``s`` again. With ``scenes`` (scene seeds, e.g. held-out scenes chosen
+    once for a comparison), episode ``k`` builds ``scenes[k % len(scenes)]`` instead. After a
+    reset, ``world`` is the episode's :class:`World`.
+    """
+
+    metadata: ClassVar[dict[str, Any]] = {"render_modes": ["rgb_array"]}  # type: ignore[misc]
+
+    def __init__(self, plan: Plan, cfg: GenerateConfig, *, seed: int = 0, max_steps: int | None = None,
+                 render_mode: str | None = None, scenes: Sequence[int] | None = None) -> None:
+        if render_mode not in (None, "rgb_array"):
+            raise ConfigError(f"render_mode {render_mode!r} is not supported; use None or 'rgb_array'")
+        if max_steps is not None and (isinstance(max_steps, bool) or not isinstance(max_steps, int)
+                                      or max_steps < 1):
+            raise ConfigError(f"max_steps must be a positive integer, got {max_steps!r}")
+        self.plan, self.cfg, self.render_mode = plan, cfg, render_mode
+        self.max_steps = max_steps or STEPS_PER_SUBTASK * len(plan.subtasks)
+        self.metadata = {**self.metadata, "render_fps": cfg.sim.control_hz}  # type: ignore[misc]
+        self.features = {k: f for k, f in dataset_features(plan).items()
+                         if k in (STATE, EE_POSE, ENVIRONMENT)}
+        self._base, self._episode = int(seed), 0
+        self.scenes = [int(x) for x in scenes] if scenes is not None else None
+        if self.scenes is not None and (not self.scenes or min(self.scenes) < 0):
+            raise ConfigError(f"scenes must be a non-empty list of non-negative scene seeds, got {scenes!r}")
+        self._instantiator = Instantiator(cfg.scene, cfg.sim, reach_map())
+        limits = self._arm_limits()
+        self.action_space = spaces.Box(np.append(limits[:, 0], 0.0).astype(np.float32),
+                                       np.append(limits[:, 1], 1.0).astype(np.float32), dtype=np.float32)
+        n = len(plan.objects)
+        pose = np.r_[np.full(3, POS_LIMIT), np.ones(4)].astype(np.float32)
+        self.observation_space = spaces.Dict({  # type: ignore[assignment]
+            STATE: spaces.Box(np.append(limits[:, 0] - 0.1, -0.01).astype(np.float32),
+                              np.append(limits[:, 1] + 0.1, 2 * GRIPPER_OPEN + 0.01).astype(np.float32),
+                              dtype=np.float32),
+            EE_POSE: spaces.Box(-pose, pose, dtype=np.float32),
+            ENVIRONMENT: spaces.Box(-np.tile(pose, n), np.tile(pose, n), dtype=np.float32),
+        })
+        self.world: World | None = None
+        self.scene_seed: int | None = None
+        self._oracle = Oracle()
+        self._done = self._streak = self._steps = 0
+        self._renderer: Renderer | None = None
+
+    # -- episodes --------------------------------------------------------------------------------
+    def _scene(self, seed: int) -> World:
+        """The settled world of a scene seed; PlacementError/SceneError/SimulationError if there is none."""
+        rng = np.random.default_rng(seed)
+        layout = plan_layout(self.plan, rng, self.cfg.randomization, self.cfg.scene.clutter)
+        spec, stats = self._instantiator.place(layout, rng)
+        instance = self._instantiator.realize(spec, stats)
+        if not instance.valid:
+            assert instance.stability is not None
+            raise SceneError(instance.stability.reason())
+        return instance.world
+
+    def _arm_limits(self) -> np.ndarray:
+        """(7, 2) joint limits of the arm (the robot is the same in every scene): from the first
+        evaluation scene, which reset() builds again."""
+        world, _ = self._first_scene(self._base, 0)
+        return world.robot.arm_limits.astype(np.float32)
+
+    def _first_scene(self, base: int, episode: int) -> tuple[World, int]:
+        """The first valid scene of evaluation episode ``episode`` and its seed."""
+        reasons = []
+        for j in range(self.cfg.max_attempts):
+            scene_seed = eval_seed(base, episode, j)
+            try:
+                return self._scene(scene_seed), scene_seed
+            except (PlacementError, SceneError, SimulationError) as exc:
+                reasons.append(str(exc).split(";")[0][:120])
+        raise SceneError(f"no valid evaluation scene for episode {episode} in {self.cfg.max_attempts} tries "
+                         f"({'; '.join(reasons[:3])}); raise max_attempts or reduce the clutter")
+
+    def reset(self, *, seed: int | None = None,
+              options: dict[str, Any] | None = None) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
+        super().reset(seed=seed)
+        if seed is not None:
+            self._base, self._episode = int(seed), 0
+        if options and options.get("scene_seed") is not None:  # an audit: e.g. a training episode's scene
+            scene_seed = int(options["scene_seed"])
+            world = self._scene(scene_seed)
+        elif self.scenes is not None:
+            scene_seed = self.scenes[self._episode % len(self.scenes)]
+            world = self._scene(scene_seed)
+            self._episode += 1
+        else:
+            world, scene_seed = self._first_scene(self._base, self._episode)
+            self._episode += 1
+        self._close_renderer()
+        self.world, self.scene_seed = world, scene_seed
+        self._done = self._streak = self._steps = 0
+        self._oracle.begin(self.plan.subtasks[0].predicates)
+        return observe(world, self.plan), self._info()
+
+    def step(self, action: np.ndarray) -> tuple[dict[str, np.ndarray], float, bool, bool, dict[str, Any]]:
+        world = self.world
+        if world is None or self._done == len(self.plan.subtasks) or self._steps >= self.max_steps:
+            raise ResetNeeded("call reset() before step(), and again after an episode ends")
+        action = np.asarray(action, dtype=float).reshape(-1)
+        if action.shape != (8,) or not np.isfinite(action).all():
+            raise ValueError(f"an action is 8 finite numbers (7 joint targets, gripper), got {action!r}")
+        world.step(world.robot.ctrl(action[:7], float(action[7])))
+        self._steps += 1
+        self._oracle.on_step(world)
+        reward = 0.0
+        subtask = self.plan.subtasks[self._done]
+        if all(self._oracle.value(world, p) for p in subtask.predicates):
+            self._streak += 1
+        else:
+            self._streak = 0
+        if self._streak >= HOLD_STEPS:
+            self._done, self._streak = self._done + 1, 0
+            if self._done < len(self.plan.subtasks):
+                self._oracle.begin(self.plan.subtasks[self._done].predicates)
+            else:
+                reward = 1.0
+        terminated = self._done == len(self.plan.subtasks)
+        truncated = not terminated and self._steps >= self.max_steps
+        return observe(world, self.plan), reward, terminated, truncated, self._info()
+
+    def _info(self) -> dict[str, Any]:
+        n = len(self.plan.subtasks)
+        return {"success": self._done == n, "subtasks_done": self._done, "subtasks": n,
+                "progress": self._done / n, "scene_seed": self.scene_seed}
+
+    # -- rendering -------------------------------------------------------------------------------
+    def render(self) -> np.ndarray | None:  # type: ignore[override]
+        if self.render_mode != "rgb_array" or self.world is None:
+            return None
+        if self._renderer is None:
+            self._renderer = Renderer(self.world, *self.cfg.render.size, self.cfg.render.mesh_detail)
+        return self._renderer.rgb(self.cfg.render.cameras[0]).copy()
+
+    def _close_renderer(self) -> None:
+        if self._renderer is not None:
+            self._renderer.close()
+            self._renderer = None
+
+    def close(self) -> None:
+        self._close_renderer()
+        super().close()
