@@ -14,7 +14,7 @@ determiner, a colour, a size or a preposition ("the can", "on the stamp mat"), n
 from __future__ import annotations
 
 import re
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -79,6 +79,25 @@ def words(text: str) -> list[str]:
     """Lower-case words and the punctuation that separates them (``rubik's`` -> ``rubiks``)."""
     text = re.sub(r"\brubik'?s\b", "rubiks", text.lower().replace("\u2019", "'"))
     return re.findall(r"[a-z0-9]+|[,;.!?]", text)
+
+
+def determiner_phrases(ws: list[str], stops: Callable[[str], bool],
+                       longest: int = 3) -> list[tuple[str, list[str]]]:
+    """Phrases a determiner introduces in the words ``ws`` ("the laptop", "a blue mug"): each
+    determiner with up to ``longest`` words after it, ending at punctuation, another determiner or
+    a word ``stops`` accepts; determiners with no word after them are left out."""
+    out = []
+    for i, w in enumerate(ws):
+        if w not in DETERMINERS:
+            continue
+        run = []
+        for nxt in ws[i + 1:i + 1 + longest]:
+            if not nxt.isalnum() or nxt in DETERMINERS or stops(nxt):
+                break
+            run.append(nxt)
+        if run:
+            out.append((w, run))
+    return out
 
 
 @dataclass(frozen=True)

@@ -33,12 +33,12 @@ from vcage.planning.language import Matcher, Scored, bounded, tokens
 from vcage.planning.lexicon import (
     ALIASES,
     COLOURS,
-    DETERMINERS,
     NOUN_WORDS,
     PREPOSITIONS,
     SIZES,
     Mention,
     ObjectRef,
+    determiner_phrases,
     find_mentions,
     listed,
     parse_phrase,
@@ -360,19 +360,9 @@ class OfflinePlanner:
 
     def _unknown_phrases(self, text: str) -> list[str]:
         """Noun phrases ("the laptop", "a song") none of whose words is an object or a goal word."""
-        ws = words(text)
-        out = []
-        for i, w in enumerate(ws):
-            if w not in DETERMINERS:
-                continue
-            run = []
-            for nxt in ws[i + 1:i + 4]:
-                if not nxt.isalnum() or nxt in DETERMINERS or nxt in PREPOSITIONS or not tokens(nxt):
-                    break
-                run.append(nxt)
-            if run and not any(r in self._known_words or set(tokens(r)) & self._known_words for r in run):
-                out.append(f"{w} {' '.join(run)}")
-        return out
+        phrases = determiner_phrases(words(text), lambda w: w in PREPOSITIONS or not tokens(w))
+        return [f"{det} {' '.join(run)}" for det, run in phrases
+                if not any(r in self._known_words or set(tokens(r)) & self._known_words for r in run)]
 
     @staticmethod
     def _cover(objects: tuple[PlanObject, ...],

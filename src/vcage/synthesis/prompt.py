@@ -6,7 +6,7 @@ import re
 from dataclasses import dataclass
 
 from vcage.planning.language import bounded
-from vcage.planning.lexicon import DETERMINERS, Mention, find_mentions
+from vcage.planning.lexicon import DETERMINERS, Mention, determiner_phrases, find_mentions
 from vcage.planning.lexicon import words as lexicon_words
 from vcage.synthesis.errors import PromptError
 from vcage.synthesis.text import tokens
@@ -45,19 +45,7 @@ def lexicon_mentions(text: str) -> tuple[list[str], list[Mention]]:
 
 def noun_phrases(text: str) -> list[str]:
     """Phrases a determiner introduces ("the laptop", "a blue mug"), up to three words each."""
-    ws = lexicon_words(text)
-    out = []
-    for i, w in enumerate(ws):
-        if w not in DETERMINERS:
-            continue
-        run = []
-        for nxt in ws[i + 1:i + 4]:
-            if nxt in DETERMINERS or nxt in STOPPERS or not nxt.isalnum():
-                break
-            run.append(nxt)
-        if run:
-            out.append(" ".join(run))
-    return out
+    return [" ".join(run) for _, run in determiner_phrases(lexicon_words(text), STOPPERS.__contains__)]
 
 
 @dataclass(frozen=True)
