@@ -363,6 +363,14 @@ class Scan:
             out[self.root / rel].append(i)
         return out
 
+    def _source(self, path: Path, episodes: list[int]) -> Path | None:
+        """The file holding ``path``'s committed bytes (see the module's docstring), or None with
+        the episodes it holds marked, if it is missing."""
+        if not path.is_file():
+            self._each(path, episodes, "missing")
+            return None
+        return committed_version(path, self.episodes)
+
     def _each(self, path: Path, episodes: list[int], what: str) -> None:
         for i in episodes:
             self.add(path, i, what)
@@ -372,10 +380,9 @@ class Scan:
         features = [k for k, f in self.static["features"].items() if f.get("dtype") != "video"]
         for path, episodes in self._grouped(self.static.get("data_path"), "data").items():
             lengths = {i: int(self.rows[i]["length"]) for i in episodes}
-            if not path.is_file():
-                self._each(path, episodes, "missing")
+            source = self._source(path, episodes)
+            if source is None:
                 continue
-            source = committed_version(path, self.episodes)
             try:
                 parquet = pq.ParquetFile(source)
                 names = set(parquet.schema_arrow.names)
@@ -426,10 +433,9 @@ class Scan:
             height, width = int(feature["shape"][0]), int(feature["shape"][1])
             for path, episodes in self._grouped(self.static.get("video_path"), f"videos/{key}", key).items():
                 expected = sum(int(self.rows[i]["length"]) for i in episodes)
-                if not path.is_file():
-                    self._each(path, episodes, "missing")
+                source = self._source(path, episodes)
+                if source is None:
                     continue
-                source = committed_version(path, self.episodes)
                 try:
                     probe = video.probe_video(source)
                 except CorruptDatasetError as exc:
