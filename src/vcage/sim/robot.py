@@ -28,6 +28,11 @@ TCP_SITE = f"{PREFIX}tcp"
 BASE_BODY = f"{PREFIX}panda0_link0"
 WRIST_CAMERA = f"{PREFIX}wrist"
 GRIPPER_OPEN = 0.04  # metres per finger
+# The box bounding the open fingers' collision geoms in the TCP frame (from the geoms' bounding
+# boxes in the model; a test keeps these true): it reaches FINGER_OUTER from the TCP along the
+# closing axis and FINGER_HALF_WIDTH across it. A neighbour inside it blocks a grasp's descent.
+FINGER_OUTER = 0.070
+FINGER_HALF_WIDTH = 0.022
 # A comfortable home posture with the hand pointing down above the table.
 HOME_QPOS = np.array([0.0, -0.5, 0.0, -2.4, 0.0, 0.35, 0.0])
 # Distance from link7's origin to the point midway between the finger pads.

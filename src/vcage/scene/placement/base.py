@@ -12,11 +12,13 @@ import math
 import time
 from abc import ABC, abstractmethod
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 import shapely
 
 from vcage.assets.catalog import CATALOG, ObjectType
+from vcage.config import from_fields
 from vcage.errors import PlacementError
 from vcage.registry import Registry
 from vcage.scene.layout import LayoutObject, LayoutSpec, relation_order, validate
@@ -38,15 +40,33 @@ class PlacementConfig:
     max_backtracks: int = 10  # distractors re-placed before giving up
     rejection_tries: int = 5000  # the rejection baseline's tries per object (robosuite's default)
     drop: float = 0.002  # objects start this far above their support, so they never start in it
+    # Keep every footprint out of the ground the open fingers sweep to grasp a task object (context
+    # placement), with this much slack around the fingers' boxes.
+    finger_zones: bool = True
+    finger_slack: float = 0.005
 
     def __post_init__(self) -> None:
         for name in ("margin", "task_clearance", "tall_clearance", "edge_margin", "base_keepout",
-                     "drop"):
+                     "drop", "finger_slack"):
             if getattr(self, name) < 0:
                 raise PlacementError(f"placement config {name} must be >= 0")
         if self.yaw_tries < 1 or self.rejection_tries < 1 or self.max_backtracks < 0:
             raise PlacementError("placement config: yaw_tries and rejection_tries must be >= 1, "
                                  "max_backtracks >= 0")
+
+    @classmethod
+    def from_dict(cls, data: dict[str, Any]) -> PlacementConfig:
+        """Read a config. A complete one stored before finger zones existed (it has every field of
+        then, not ``finger_zones``) placed without them and keeps doing so, so its runs reproduce."""
+        if isinstance(data, dict) and set(_FIELDS_BEFORE_FINGER_ZONES) <= set(data) \
+                and "finger_zones" not in data:
+            data = {**data, "finger_zones": False}
+        return from_fields(cls, data)
+
+
+_FIELDS_BEFORE_FINGER_ZONES = ("margin", "task_clearance", "tall_clearance", "tall_height", "edge_margin",
+                               "base_keepout", "reach_distractors", "yaw_tries", "max_backtracks",
+                               "rejection_tries", "drop")
 
 
 @dataclass

@@ -4,7 +4,8 @@ Each support surface has a :class:`SurfaceMap`. The table's map starts with the 
 keep-out and the reserved zones; every placed footprint is added to it. An object's origin is
 drawn uniformly from its domain (the table eroded by its footprint, within the arm's top-down
 reach, its region and its relations) minus the configuration-space obstacles of everything on the
-map, at a sampled yaw. Distractors keep extra clearance from task objects (more when tall). When
+map, at a sampled yaw. Distractors keep extra clearance from task objects (more when tall), and
+nothing stands where the open fingers go down to grasp a task object (its finger zone). When
 an object does not fit, the most recently placed distractors are taken off again and re-placed
 after it, a bounded number of times; then a :class:`PlacementError` names the object, the surface
 and the free area left.
@@ -14,6 +15,7 @@ from __future__ import annotations
 
 import math
 import time
+from dataclasses import replace
 
 import numpy as np
 import shapely
@@ -26,7 +28,7 @@ from vcage.errors import PlacementError
 from vcage.scene.layout import LayoutObject, LayoutSpec
 from vcage.scene.placement.base import PLACERS, PlacementStats, Placer, Pose, height, support_frame
 from vcage.scene.placement.free_space import Occupant, SurfaceMap
-from vcage.scene.placement.geometry import erode_box, footprint, rotated_rect, sample_point
+from vcage.scene.placement.geometry import erode_box, footprint, grasp_zone, rotated_rect, sample_point
 from vcage.scene.spec import ROBOT_MOUNT
 
 FAR = 10.0  # half-planes are boxes this large
@@ -96,7 +98,8 @@ class ContextAwarePlacer(Placer):
             shape = footprint(obj.type, obj.scale, yaw)
             domain = self._domain(obj, shape, poses)
             grown = shape.buffer(self.config.margin, join_style="mitre")
-            free = surface.free(grown, obj.task, tall, self._clearance, domain)
+            zone = self._zone(obj, yaw, (0.0, 0.0))
+            free = surface.free(grown, obj.task, tall, self._clearance, domain, zone)
             if pinned:
                 assert obj.region is not None
                 if free.distance(Point(obj.region.center)) <= 1e-9:
@@ -168,12 +171,18 @@ class ContextAwarePlacer(Placer):
         distractor_tall = tall if occ.task else occ.tall
         return self.config.tall_clearance if distractor_tall else self.config.task_clearance
 
+    def _zone(self, obj: LayoutObject, yaw: float, xy: tuple[float, float]) -> Polygon | None:
+        """The finger zone of a task object standing on the table (None for the others)."""
+        if not (self.config.finger_zones and obj.task and obj.support.is_table):
+            return None
+        return grasp_zone(obj.type, obj.scale, yaw, xy, self.config.finger_slack)
+
     def _commit(self, obj: LayoutObject, pose: Pose) -> None:
         occ = Occupant(obj.name, footprint(obj.type, obj.scale, pose.yaw, pose.xy), obj.task,
-                       height(obj) > self.config.tall_height)
+                       height(obj) > self.config.tall_height, self._zone(obj, pose.yaw, pose.xy))
         self.maps["table"].add(occ)
         if not obj.support.is_table:
-            self.maps[obj.support.label()].add(occ)
+            self.maps[obj.support.label()].add(replace(occ, zone=None))
 
     def _uncommit(self, obj: LayoutObject) -> None:
         self.maps["table"].remove(obj.name)

@@ -16,6 +16,7 @@ from shapely.geometry import MultiPoint, Point, Polygon
 from shapely.geometry.base import BaseGeometry
 
 from vcage.assets.catalog import CATALOG
+from vcage.sim.robot import FINGER_HALF_WIDTH, FINGER_OUTER
 
 EMPTY = Polygon()
 Vec2 = Sequence[float] | np.ndarray  # an (x, y) pair
@@ -26,6 +27,23 @@ def footprint(type_name: str, scale: float, yaw: float, xy: tuple[float, float] 
     """The object's resting rectangle (its size box, grown by ``pad``) at ``xy`` and ``yaw``."""
     sx, sy = (s * scale for s in CATALOG.get(type_name).size[:2])
     return rotated_rect(xy, yaw, (sx / 2 + pad, sy / 2 + pad))
+
+
+def grasp_zone(type_name: str, scale: float, yaw: float, xy: tuple[float, float] = (0.0, 0.0),
+               slack: float = 0.0) -> Polygon | None:
+    """Where the open fingers go down when ``type_name`` at ``xy`` and ``yaw`` is grasped: the
+    convex hull of its footprint and, for every annotated grasp, the open fingers' box (grown by
+    ``slack``). Another object's footprint inside it blocks that grasp. None without grasps."""
+    otype = CATALOG.get(type_name)
+    if not otype.grasps:
+        return None
+    boxes = [footprint(type_name, scale, yaw, xy)]
+    half = (FINGER_HALF_WIDTH + slack, FINGER_OUTER + slack)  # gripper x, closing axis
+    for g in otype.grasps:
+        center = to_world(xy, yaw, (g.pos[0] * scale, g.pos[1] * scale))
+        boxes.append(rotated_rect(center, yaw + g.yaw, half))
+    hull = shapely.union_all(boxes).convex_hull
+    return hull if isinstance(hull, Polygon) else None
 
 
 def to_world(center: Vec2, yaw: float, local: Vec2) -> np.ndarray:
