@@ -56,22 +56,23 @@ def slug(text: str) -> str:
     return re.sub(r"[^a-z0-9]+", "_", text.lower()).strip("_")[:60]
 
 
-def generation_config(method: str, seed: int, size: int) -> Any:
+def generation_config(method: str, seed: int, size: int, workers: int = 1) -> Any:
     from vcage.config import RenderConfig
-    from vcage.pipeline.config import GenerateConfig
+    from vcage.pipeline.config import ExecutorConfig, GenerateConfig
 
     render = RenderConfig(size=(size, size), cameras=("front",))  # state-based policies: one small video
     cfg = GenerateConfig(seed=seed) if method == "vcage" else GenerateConfig.vanilla(seed=seed)
-    return replace(cfg, render=render)
+    return replace(cfg, render=render, executor=ExecutorConfig(workers=workers))
 
 
-def make_datasets(task: str, work: Path, demos: int, seed: int, size: int) -> dict[str, Path]:
+def make_datasets(task: str, work: Path, demos: int, seed: int, size: int,
+                  workers: int = 1) -> dict[str, Path]:
     from vcage.pipeline.generate import generate
 
     out = {}
     for method in METHODS:
         root = work / "data" / slug(task) / method
-        funnel = generate(task, demos, root, generation_config(method, seed, size), total=True)
+        funnel = generate(task, demos, root, generation_config(method, seed, size, workers), total=True)
         print(f"  {method:8s} {funnel.dataset_episodes} demos ({funnel.attempts} attempts this run)",
               flush=True)
         out[method] = root
@@ -118,7 +119,8 @@ def train_and_evaluate(task: str, method: str, dataset: Path, env_config: dict[s
                          checkpoint_every=max(1, min(500, args.steps)))
     summary = train(dataset, run, config, resume=True, threads=args.threads)
     evaluation = evaluate(run, len(scenes), seed=0, max_steps=args.max_steps, env_config=env_config,
-                          threads=args.threads, make_env=functools.partial(make_env, scenes=scenes))
+                          threads=args.threads, make_env=functools.partial(make_env, scenes=scenes),
+                          workers=args.workers)
     out = evaluation.to_dict() | {"task": task, "method": method, "train_seed": train_seed,
                                   "train_seconds": summary.seconds,
                                   "train_samples_per_second": summary.samples_per_second,
@@ -221,7 +223,9 @@ def main() -> None:
     parser.add_argument("--max-steps", type=int, default=None, help="evaluation episode length cap")
     parser.add_argument("--seed", type=int, default=0, help="generation run seed (both methods)")
     parser.add_argument("--size", type=int, default=64, help="video size (the policy is state-based)")
-    parser.add_argument("--threads", type=int, default=1)
+    parser.add_argument("--threads", type=int, default=1, help="torch threads per process")
+    parser.add_argument("--workers", type=int, default=1,
+                        help="processes for generation and evaluation rollouts (same results as one)")
     parser.add_argument("--bootstrap", type=int, default=2000)
     parser.add_argument("--quick", action="store_true", help="smoke path: tiny everything")
     args = parser.parse_args()
@@ -236,7 +240,7 @@ def main() -> None:
     t0 = time.perf_counter()
     for task in tasks:
         print(f"{task}:", flush=True)
-        datasets = make_datasets(task, args.work, args.demos, args.seed, args.size)
+        datasets = make_datasets(task, args.work, args.demos, args.seed, args.size, args.workers)
         noise[task] = audit(datasets["vanilla"]).label_noise
         scenes = solvable_scenes(task, datasets["vcage"], args.work, args.eval, base=1000 + args.seed)
         from vcage.data import DatasetReader

@@ -82,3 +82,18 @@ def tiny(policy: str, **changes: object) -> TrainConfig:
                                "mlp": MlpConfig(hidden=(64, 64))}
     base.update(changes)
     return TrainConfig(**base)  # type: ignore[arg-type]
+
+
+@pytest.fixture(scope="session")
+def generated(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """Two real episodes of "press the bell" (oracle critic, no clutter, one small camera)."""
+    from typer.testing import CliRunner
+
+    from vcage.cli import app
+
+    out = tmp_path_factory.mktemp("generated") / "bell"
+    result = CliRunner().invoke(app, ["generate", "press the bell", "--episodes", "2", "--critic", "oracle",
+                                      "--clutter", "0", "--size", "64", "--cameras", "front",
+                                      "--out", str(out)])
+    assert result.exit_code == 0, result.output
+    return out

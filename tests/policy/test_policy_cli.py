@@ -20,15 +20,6 @@ def flat(text: str) -> str:
     return " ".join(text.split())
 
 
-@pytest.fixture(scope="module")
-def generated(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    out = tmp_path_factory.mktemp("generated") / "bell"
-    result = RUN.invoke(app, ["generate", "press the bell", "--episodes", "2", "--critic", "oracle",
-                              "--clutter", "0", "--size", "64", "--cameras", "front", "--out", str(out)])
-    assert result.exit_code == 0, result.output
-    return out
-
-
 @pytest.mark.parametrize("policy", ["mlp", "diffusion"])
 def test_train_then_evaluate_in_the_datasets_environment(generated: Path, tmp_path: Path,
                                                          policy: str) -> None:

@@ -24,7 +24,9 @@ def evaluate_cmd(
         env: Path = typer.Option(None, help="evaluate in the environment of this dataset instead of the "
                                  "one the checkpoint was trained on"),
         device: str = typer.Option("cpu", help="cpu, or cuda when a GPU is present"),
-        threads: int = typer.Option(None, min=1, help="torch CPU threads (default: torch's choice)"),
+        threads: int = typer.Option(None, min=1, help="torch CPU threads (default: torch's choice; 1 per "
+                                    "worker with --workers)"),
+        workers: int = typer.Option(1, min=1, help="processes sharing the episodes (same results as one)"),
         json_out: Path = typer.Option(None, "--json",
                                       help="also write the results to this JSON file")) -> None:
     """Roll out CHECKPOINT for --episodes episodes: success rate (Wilson 95% interval), progress per
@@ -53,7 +55,7 @@ def evaluate_cmd(
 
     try:
         result = evaluate(checkpoint, episodes, seed=seed, max_steps=max_steps, env_config=env_config,
-                          device=device, threads=threads, progress=update)
+                          device=device, threads=threads, progress=update, workers=workers)
     finally:
         if bar.live.is_started:
             bar.stop()

@@ -72,12 +72,14 @@ class GoalEnv(gym.Env[dict[str, np.ndarray], np.ndarray]):
     """The plan ``plan`` in scenes sampled as ``cfg`` samples them, as a Gymnasium environment.
 
     ``reset()`` without a seed moves to the next evaluation episode; ``reset(seed=s)`` starts the
-    episode sequence of seed ``s`` again. With ``scenes`` (scene seeds, e.g. held-out scenes chosen
-    once for a comparison), episode ``k`` builds ``scenes[k % len(scenes)]`` instead. After a
-    reset, ``world`` is the episode's :class:`World`.
+    episode sequence of seed ``s`` again; ``options={"episode": k}`` goes to episode ``k`` directly
+    (so that several processes can share one evaluation's episodes). With ``scenes`` (scene seeds,
+    e.g. held-out scenes chosen once for a comparison), episode ``k`` builds
+    ``scenes[k % len(scenes)]`` instead. After a reset, ``world`` is the episode's :class:`World`.
     """
 
     metadata: ClassVar[dict[str, Any]] = {"render_modes": ["rgb_array"]}  # type: ignore[misc]
+    episode_option: ClassVar[bool] = True  # reset(options={"episode": k}) starts episode k
 
     def __init__(self, plan: Plan, cfg: GenerateConfig, *, seed: int = 0, max_steps: int | None = None,
                  render_mode: str | None = None, scenes: Sequence[int] | None = None) -> None:
@@ -96,6 +98,7 @@ class GoalEnv(gym.Env[dict[str, np.ndarray], np.ndarray]):
         if self.scenes is not None and (not self.scenes or min(self.scenes) < 0):
             raise ConfigError(f"scenes must be a non-empty list of non-negative scene seeds, got {scenes!r}")
         self._instantiator = Instantiator(cfg.scene, cfg.sim, reach_map())
+        self._prebuilt: tuple[int, int, World, int] | None = None  # (base, episode, world, scene seed)
         limits = self._arm_limits()
         self.action_space = spaces.Box(np.append(limits[:, 0], 0.0).astype(np.float32),
                                        np.append(limits[:, 1], 1.0).astype(np.float32), dtype=np.float32)
@@ -118,7 +121,8 @@ class GoalEnv(gym.Env[dict[str, np.ndarray], np.ndarray]):
     def _scene(self, seed: int) -> World:
         """The settled world of a scene seed; PlacementError/SceneError/SimulationError if there is none."""
         rng = np.random.default_rng(seed)
-        layout = plan_layout(self.plan, rng, self.cfg.randomization, self.cfg.scene.clutter)
+        layout = plan_layout(self.plan, rng, self.cfg.randomization, self.cfg.scene.clutter,
+                             scene=self.cfg.synthesized)
         spec, stats = self._instantiator.place(layout, rng)
         instance = self._instantiator.realize(spec, stats)
         if not instance.valid:
@@ -127,10 +131,21 @@ class GoalEnv(gym.Env[dict[str, np.ndarray], np.ndarray]):
         return instance.world
 
     def _arm_limits(self) -> np.ndarray:
-        """(7, 2) joint limits of the arm (the robot is the same in every scene): from the first
-        evaluation scene, which reset() builds again."""
-        world, _ = self._first_scene(self._base, 0)
+        """(7, 2) joint limits of the arm (the robot is the same in every scene): from the scene of
+        the first episode, kept for the reset that starts it."""
+        world, scene_seed = self._episode_scene(self._base, 0)
+        self._prebuilt = (self._base, 0, world, scene_seed)
         return world.robot.arm_limits.astype(np.float32)
+
+    def _episode_scene(self, base: int, episode: int) -> tuple[World, int]:
+        """The world of evaluation episode ``episode`` of seed ``base``, and its scene seed."""
+        prebuilt, self._prebuilt = self._prebuilt, None
+        if prebuilt is not None and prebuilt[:2] == (base, episode):
+            return prebuilt[2], prebuilt[3]
+        if self.scenes is not None:
+            scene_seed = self.scenes[episode % len(self.scenes)]
+            return self._scene(scene_seed), scene_seed
+        return self._first_scene(base, episode)
 
     def _first_scene(self, base: int, episode: int) -> tuple[World, int]:
         """The first valid scene of evaluation episode ``episode`` and its seed."""
@@ -149,15 +164,17 @@ class GoalEnv(gym.Env[dict[str, np.ndarray], np.ndarray]):
         super().reset(seed=seed)
         if seed is not None:
             self._base, self._episode = int(seed), 0
-        if options and options.get("scene_seed") is not None:  # an audit: e.g. a training episode's scene
+        options = options or {}
+        if options.get("episode") is not None:
+            episode = options["episode"]
+            if isinstance(episode, bool) or not isinstance(episode, int | np.integer) or episode < 0:
+                raise ConfigError(f"options['episode'] must be an episode index >= 0, got {episode!r}")
+            self._episode = int(episode)
+        if options.get("scene_seed") is not None:  # an audit: e.g. a training episode's scene
             scene_seed = int(options["scene_seed"])
             world = self._scene(scene_seed)
-        elif self.scenes is not None:
-            scene_seed = self.scenes[self._episode % len(self.scenes)]
-            world = self._scene(scene_seed)
-            self._episode += 1
         else:
-            world, scene_seed = self._first_scene(self._base, self._episode)
+            world, scene_seed = self._episode_scene(self._base, self._episode)
             self._episode += 1
         self._close_renderer()
         self.world, self.scene_seed = world, scene_seed

@@ -119,10 +119,26 @@ def check_compatible(checkpoint: Mapping[str, Any], env: gym.Env) -> None:
                                        "of the dataset it was trained on")
 
 
-def rollout(runner: PolicyRunner, env: gym.Env, seed: int | None = None) -> EpisodeResult:
-    """One episode of ``runner`` in ``env`` (reset with ``seed``, if given), to its end."""
-    runner.reset()
-    obs, info = env.reset(seed=seed)
+def episode_noise_seed(seed: int, episode: int) -> int:
+    """The seed of the diffusion sampler's noise in evaluation episode ``episode`` of ``seed``."""
+    return int(np.random.SeedSequence([seed, episode]).generate_state(1)[0])
+
+
+def rollout(runner: PolicyRunner, env: gym.Env, seed: int | None = None,
+            episode: int | None = None) -> EpisodeResult:
+    """One episode of ``runner`` in ``env`` (reset with ``seed``, if given), to its end.
+
+    With ``episode``, the environment is asked for that episode (``options={"episode": k}``, which
+    :class:`~vcage.pipeline.evaluation.GoalEnv` honours) and the sampler's noise restarts from
+    :func:`episode_noise_seed`: the episode's outcome then depends on nothing run before it."""
+    if episode is None:
+        runner.reset()
+        obs, info = env.reset(seed=seed)
+    else:
+        if seed is None:
+            raise PolicyError("a rollout of a given episode needs the evaluation seed")
+        runner.reset(episode_noise_seed(seed, episode))
+        obs, info = env.reset(seed=seed, options={"episode": episode})
     steps, terminated, truncated = 0, False, False
     while not (terminated or truncated):
         obs, _, terminated, truncated, info = env.step(runner.act(obs))
@@ -141,12 +157,21 @@ def default_factory() -> EnvFactory:
 def evaluate(checkpoint: str | Path, episodes: int, *, seed: int = 0, max_steps: int | None = None,
              env_config: dict[str, Any] | None = None, device: str = "cpu", threads: int | None = None,
              make_env: EnvFactory | None = None,
-             progress: Callable[[int, int, EpisodeResult], None] | None = None) -> Evaluation:
+             progress: Callable[[int, int, EpisodeResult], None] | None = None,
+             workers: int = 1) -> Evaluation:
     """Roll out ``checkpoint`` (a file, or a training run's directory: its latest) for ``episodes``
     episodes of the environment of ``env_config`` (default: the configuration of the dataset it was
-    trained on), seeded ``seed``; ``threads`` caps torch's CPU threads for the duration."""
+    trained on), seeded ``seed``; ``threads`` caps torch's CPU threads for the duration.
+
+    Episode ``k`` is the environment's episode ``k`` with the sampler noise of
+    :func:`episode_noise_seed`, so ``workers`` processes (each rolling out its share, with
+    ``threads`` torch threads, default 1) give the same episodes as one. More than one worker needs
+    an environment that can start episode ``k`` directly (``episode_option``, as ``GoalEnv``) and a
+    picklable ``make_env``."""
     if episodes < 1:
         raise PolicyError(f"--episodes must be at least 1, got {episodes}")
+    if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
+        raise PolicyError(f"--workers must be a positive integer, got {workers!r}")
     torch_device(device)
     payload = load_checkpoint(checkpoint)
     config = env_config if env_config is not None else payload["dataset"].get("config")
@@ -154,24 +179,74 @@ def evaluate(checkpoint: str | Path, episodes: int, *, seed: int = 0, max_steps:
         raise PolicyError(f"the dataset {payload['dataset']['path']} the checkpoint was trained on stores no "
                           "vcage configuration (meta/vcage.json), so there is no environment to evaluate in; "
                           "pass the environment of a vcage dataset (--env DATASET)")
-    env = (make_env or default_factory())(config, seed=seed, max_steps=max_steps)
+    factory = make_env or default_factory()
+    env = factory(config, seed=seed, max_steps=max_steps)
     old_threads = torch.get_num_threads()
     if threads is not None:
         torch.set_num_threads(threads)
     try:
         check_compatible(payload, env)
-        runner = PolicyRunner(payload, device=device, seed=seed)
-        results: list[EpisodeResult] = []
+        direct = bool(getattr(env.unwrapped, "episode_option", False))
+        if workers > 1 and not direct:
+            raise PolicyError("this environment cannot start an episode by its index, so its episodes "
+                              "cannot be shared among workers; evaluate with --workers 1")
         began = time.perf_counter()
-        for k in range(episodes):
-            results.append(rollout(runner, env, seed if k == 0 else None))
-            if progress is not None:
-                progress(k + 1, episodes, results[-1])
+        if workers > 1 and episodes > 1:
+            env.close()
+            results = _parallel(str(payload["path"]), episodes, min(workers, episodes), factory, config,
+                                seed=seed, max_steps=max_steps, device=device, threads=threads or 1,
+                                progress=progress)
+        else:
+            runner = PolicyRunner(payload, device=device, seed=seed)
+            results = []
+            for k in range(episodes):
+                if direct:  # every episode restarts from the seed: k depends on nothing before it
+                    results.append(rollout(runner, env, seed, episode=k))
+                else:
+                    results.append(rollout(runner, env, seed if k == 0 else None))
+                if progress is not None:
+                    progress(k + 1, episodes, results[-1])
         seconds = time.perf_counter() - began
     finally:
         env.close()
         torch.set_num_threads(old_threads)
     return Evaluation(str(payload["path"]), seed, tuple(results), seconds, subtask_names(config))
+
+
+# -- parallel rollouts: one environment and one policy per worker process ---------------------------
+_WORKER: dict[str, Any] = {}
+
+
+def _start_worker(path: str, factory: EnvFactory, config: dict[str, Any], seed: int,
+                  max_steps: int | None, device: str, threads: int) -> None:
+    torch.set_num_threads(threads)
+    _WORKER["runner"] = PolicyRunner(load_checkpoint(path), device=device, seed=seed)
+    _WORKER["env"] = factory(config, seed=seed, max_steps=max_steps)
+    _WORKER["seed"] = seed
+
+
+def _worker_episode(episode: int) -> tuple[int, EpisodeResult]:
+    return episode, rollout(_WORKER["runner"], _WORKER["env"], _WORKER["seed"], episode=episode)
+
+
+def _parallel(path: str, episodes: int, workers: int, factory: EnvFactory, config: dict[str, Any], *,
+              seed: int, max_steps: int | None, device: str, threads: int,
+              progress: Callable[[int, int, EpisodeResult], None] | None) -> list[EpisodeResult]:
+    """Episodes 0..episodes-1 over ``workers`` spawned processes, returned in episode order."""
+    import multiprocessing
+    from concurrent.futures import ProcessPoolExecutor, as_completed
+
+    results: dict[int, EpisodeResult] = {}
+    context = multiprocessing.get_context("spawn")  # no forked MuJoCo, GL or torch state
+    with ProcessPoolExecutor(workers, mp_context=context, initializer=_start_worker,
+                             initargs=(path, factory, config, seed, max_steps, device, threads)) as pool:
+        futures = [pool.submit(_worker_episode, k) for k in range(episodes)]
+        for future in as_completed(futures):
+            k, result = future.result()
+            results[k] = result
+            if progress is not None:
+                progress(len(results), episodes, result)
+    return [results[k] for k in range(episodes)]
 
 
 def subtask_names(config: Mapping[str, Any]) -> tuple[str, ...]:

@@ -49,10 +49,13 @@ class PolicyRunner:
     def observation_keys(self) -> tuple[str, ...]:
         return tuple(f.name for f in self.obs_features)
 
-    def reset(self) -> None:
-        """Forget the observation window and the queued actions (call at every episode start)."""
+    def reset(self, seed: int | None = None) -> None:
+        """Forget the observation window and the queued actions (call at every episode start);
+        ``seed`` restarts the sampler's noise, so an episode does not depend on the ones before."""
         self._window.clear()
         self._queue.clear()
+        if seed is not None:
+            self.generator.manual_seed(seed)
 
     def observation_vector(self, obs: Mapping[str, Any]) -> np.ndarray:
         """The policy's observation features of an environment observation, side by side."""
