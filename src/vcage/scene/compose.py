@@ -174,7 +174,10 @@ def _set_home_key(model: mujoco.MjModel) -> None:
     key.ctrl[:] = robot.ctrl(HOME_QPOS, 1.0)
 
 
-_CACHE_SIZE = 16
+# Each compiled scene holds about 24 MiB (mostly the robot meshes and their bounding-volume
+# hierarchies). Randomised scenes never repeat, so the cache only serves an attempt that compiles
+# and then realizes its scene, and unrandomised tasks that rebuild one scene: a few entries do.
+_CACHE_SIZE = 2
 _MODEL_CACHE: OrderedDict[tuple, ComposedScene] = OrderedDict()
 
 
