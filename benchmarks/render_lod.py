@@ -1,4 +1,6 @@
-"""Full versus simplified (LOD) visual meshes: what a frame costs and what it shows.
+"""Full versus level-of-detail (LOD) rendering: what a frame costs and what it shows. LOD draws the
+robot's heavy visual meshes simplified and primitives tessellated more coarsely
+(``vcage.sim.lod.LOD_QUALITY``); "full" draws the model as compiled.
 
 The scene is the standard plan scene: the first accepted attempt of "get ready for work" with the
 default generation config (context placement, 4 distractors) and no critic; its recording is the
@@ -10,6 +12,7 @@ posture at 128x128 and 320x240 with full and LOD meshes. Printed per camera and 
   the postures (summed intersections over summed unions) and the lowest of one posture among those
   where the robot covers at least 100 pixels (``vis``: how many; a sliver of a few pixels says
   nothing);
+- obj IoU: the same pooled IoU for the objects' pixels (each object's label against its own);
 - MAD: mean absolute RGB difference (0-255) over all pixels; ``px>16``: share of pixels where a
   channel differs by more than 16;
 - ms per frame (update + render + read) with full and LOD meshes, the best of ``--rounds``
@@ -78,7 +81,7 @@ def postures(world: World, n: int, seed: int) -> list[np.ndarray]:
 
 def compare(world: World, states: list[np.ndarray], camera: str, full: Renderer, simple: Renderer,
             rounds: int) -> str:
-    inter = union_all = 0
+    inter = union_all = obj_inter = obj_union = 0
     ious, mads, changed = [], [], []
     for state in states:
         world.show_state(state)
@@ -90,6 +93,9 @@ def compare(world: World, states: list[np.ndarray], camera: str, full: Renderer,
         inter, union_all = inter + (sa & sb).sum(), union_all + union
         if union >= MIN_PIXELS:
             ious.append((sa & sb).sum() / union)
+        oa, ob = full.segmentation(camera), simple.segmentation(camera)
+        objects = (oa >= 0) | (ob >= 0)
+        obj_inter, obj_union = obj_inter + ((oa == ob) & objects).sum(), obj_union + objects.sum()
     ms = {"full": np.inf, "lod": np.inf}
     for _ in range(rounds):  # interleaved, so that both see the same load
         for name, renderer in (("full", full), ("lod", simple)):
@@ -102,7 +108,8 @@ def compare(world: World, states: list[np.ndarray], camera: str, full: Renderer,
             ms[name] = min(ms[name], spent / len(states) * 1e3)
     pooled = f"{inter / union_all:8.4f}" if union_all else f"{'n/a':>8s}"
     iou = f"{pooled} {np.min(ious):7.4f}" if ious else f"{pooled} {'n/a':>7s}"
-    return (f"{iou} {len(ious):4d} {np.mean(mads):6.2f} {np.mean(changed):7.2%} "
+    obj = f"{obj_inter / obj_union:8.4f}" if obj_union else f"{'n/a':>8s}"
+    return (f"{iou} {len(ious):4d} {obj} {np.mean(mads):6.2f} {np.mean(changed):7.2%} "
             f"{ms['full']:8.2f} {ms['lod']:8.2f} {ms['full'] / ms['lod']:6.2f}x")
 
 
@@ -177,7 +184,11 @@ def main() -> None:
           f"simplified meshes {int(full_faces[heavy].sum()):,} -> {int(simple_faces[heavy].sum()):,}\n")
 
     states = postures(world, args.postures, args.seed)
-    header = (f"{'camera':12s} {'size':>7s} {'IoU':>8s} {'min':>7s} {'vis':>4s} {'MAD':>6s} "
+    q = world.model.vis.quality
+    print(f"primitives (slices, stacks, quads): full {(q.numslices, q.numstacks, q.numquads)}, "
+          f"LOD {lod.LOD_QUALITY}\n")
+    header = (f"{'camera':12s} {'size':>7s} {'IoU':>8s} {'min':>7s} {'vis':>4s} {'obj IoU':>8s} "
+              f"{'MAD':>6s} "
               f"{'px>16':>7s} {'full ms':>8s} {'LOD ms':>8s} {'ratio':>7s}")
     print(header)
     for width, height in SIZES:

@@ -74,6 +74,9 @@ def test_robot_meshes_are_simplified_to_the_budget(world: World) -> None:
     assert {full.mesh(m).name for m in heavy} >= {f"panda/link{i}_viz" for i in range(8)}
     simple = lod.lod_model(full)
     assert full.mesh_facenum.sum() > 130_000 > 20_000 > simple.mesh_facenum.sum()
+    quality = (simple.vis.quality.numslices, simple.vis.quality.numstacks, simple.vis.quality.numquads)
+    assert quality == lod.LOD_QUALITY != (full.vis.quality.numslices, full.vis.quality.numstacks,
+                                          full.vis.quality.numquads)  # the drawn copy only
     for m in heavy:
         assert simple.mesh_facenum[m] <= lod.FACE_BUDGET < full.mesh_facenum[m]
         _, faces = lod.mesh_arrays(simple, m)

@@ -5,8 +5,10 @@ On a software rasteriser a frame costs its geometry, and the Panda's visual mesh
 which every mesh drawn only by visual geoms (``contype = conaffinity = 0``) with more than
 ``budget`` faces is replaced by a quadric decimation of itself (``fast_simplification``), written
 into the mesh's own slots: a mesh only shrinks, so the copy has the original's sizes and draws the
-original's ``MjData``. The copy is for drawing only; the model that is stepped is never changed,
-so collision geoms, masses and kinematics stay those of the full model.
+original's ``MjData``. It also tessellates primitives more coarsely (:data:`LOD_QUALITY`), which
+with the robot simplified is most of what is left to draw. The copy is for drawing only; the model
+that is stepped is never changed, so collision geoms, masses and kinematics stay those of the full
+model.
 
 Each simplified mesh is computed once per machine and cached in :func:`cache_dir` (beside the
 reach map) under a hash of the mesh's vertices and faces, as MuJoCo compiled them from the source
@@ -31,6 +33,12 @@ from vcage.config import MESH_DETAILS, cache_dir
 from vcage.errors import ConfigError
 
 FACE_BUDGET = 1000  # faces per simplified mesh; see benchmarks/render_lod.py for what it costs
+# How finely the renderer tessellates primitives (cylinders, spheres, capsules: slices around and
+# stacks along; boxes and planes: quads per side, over which lighting is interpolated). MuJoCo's
+# defaults are (28, 16, 4); with the robot's meshes simplified, the objects' round primitives are
+# much of a frame's geometry. Fewer quads would save more but change the shading of large faces
+# close to the wrist camera (benchmarks/render_lod.py: what it costs and what it changes).
+LOD_QUALITY = (16, 8, 4)
 VERSION = 1  # bump when the simplification or the cache format changes
 
 
@@ -50,13 +58,18 @@ def render_model(model: mujoco.MjModel, mesh_detail: str) -> mujoco.MjModel:
     return model if mesh_detail == "full" else lod_model(model)
 
 
-def lod_model(model: mujoco.MjModel, budget: int | None = None) -> mujoco.MjModel:
+def lod_model(model: mujoco.MjModel, budget: int | None = None,
+              quality: tuple[int, int, int] | None = LOD_QUALITY) -> mujoco.MjModel:
     """A copy of ``model`` whose heavy visual-only meshes are simplified to ``budget`` faces
-    (None: :data:`FACE_BUDGET` as it is now)."""
+    (None: :data:`FACE_BUDGET` as it is now) and whose primitives are drawn with ``quality``
+    (slices, stacks, quads; None: the model's own)."""
     budget = FACE_BUDGET if budget is None else budget
     out = copy.copy(model)
     for mesh in heavy_visual_meshes(model, budget):
         _write_mesh(out, mesh, simplified(*mesh_arrays(model, mesh), budget))
+    if quality is not None:
+        q = out.vis.quality
+        q.numslices, q.numstacks, q.numquads = quality
     return out
 
 
