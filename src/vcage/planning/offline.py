@@ -333,7 +333,10 @@ class OfflinePlanner:
             raise PlanningError(f"{fail}: no goal matches well enough (closest goals: {near}; a goal needs "
                                 f"a match of {threshold:.2f}; {recognised}); {self.capabilities()}")
         best = ranked[0]
-        rivals = [x for x in ranked[1:] if best.evidence <= self.matcher.vocabulary_of(x.label)]
+        said = " ".join(words(text))  # a goal's own phrasing, word for word, is that goal
+        verbatim = any(" ".join(words(p)) == said for p in self.goals[best.label].phrasings)
+        rivals = [] if verbatim else [x for x in ranked[1:]
+                                      if best.evidence <= self.matcher.vocabulary_of(x.label)]
         if rivals:
             raise PlanningError(f"{fail}: ambiguous, it fits {best.label} ({best.score:.2f}) and "
                                 f"{rivals[0].label} ({rivals[0].score:.2f}), whose phrasings both hold every "
