@@ -67,7 +67,17 @@ class Delay:
     then: Reply | Status | str = "late reply"
 
 
-Item = str | Reply | Status | Delay | Callable[[dict[str, Any]], "str | Reply | Status | Delay"]
+@dataclass(frozen=True)
+class Raw:
+    """Any JSON answer, sent as it is: for protocols whose answers :class:`Reply` cannot describe
+    (image answers, prompt blocks); see :mod:`fake_images`."""
+
+    status: int
+    payload: dict[str, Any]
+    headers: tuple[tuple[str, str], ...] = ()
+
+
+Item = str | Reply | Status | Delay | Raw | Callable[[dict[str, Any]], "str | Reply | Status | Delay | Raw"]
 
 
 class FakeOpenAI:
@@ -142,6 +152,11 @@ class FakeOpenAI:
         data = [{"id": m, "object": "model", "created": 0, "owned_by": "fake-openai"} for m in self.models]
         return {"object": "list", "data": data}
 
+    def parse(self, raw: bytes, content_type: str) -> dict[str, Any]:
+        """The request body of a served POST as a dict; ValueError answers 400."""
+        body: dict[str, Any] = json.loads(raw)
+        return body
+
     def not_found(self, method: str, path: str) -> str:
         """The message of a 404 for ``method path``."""
         return f"no route {method} {path}"
@@ -198,7 +213,7 @@ def _handler_class(server: FakeOpenAI) -> type[BaseHTTPRequestHandler]:
                 self._send(404, server.error(404, f"no route POST {self.path}"))
                 return
             try:
-                body = json.loads(raw)
+                body = server.parse(raw, self.headers.get("Content-Type") or "")
             except ValueError:
                 self._send(400, server.error(400, "request body is not valid JSON"))
                 return
@@ -217,6 +232,8 @@ def _handler_class(server: FakeOpenAI) -> type[BaseHTTPRequestHandler]:
             elif isinstance(item, Status):
                 headers = {"Retry-After": item.retry_after, "retry-after-ms": item.retry_after_ms}
                 self._send(item.status, server.error(item.status, item.message, item.retry_delay), headers)
+            elif isinstance(item, Raw):
+                self._send(item.status, item.payload, dict(item.headers))
             elif isinstance(item, (str, Reply)):
                 reply = Reply(item) if isinstance(item, str) else item
                 self._send(200, server.success(self.path, body, reply))

@@ -74,3 +74,25 @@ def test_empty_or_meaningless_prompts_are_typed_errors(prompt: str) -> None:
 def test_an_impossible_prompt_is_a_description_error() -> None:
     with pytest.raises(SceneDescriptionError, match="too large"):
         describe("put the pot in the cup")
+
+
+def test_the_names_an_object_again_and_a_names_a_new_one() -> None:
+    desc, _ = describe("a mouse pad behind a mouse, a cup right of the mouse pad")
+    assert [o.type for o in desc.objects] == ["mouse_pad", "mouse", "cup"]
+    assert {str(r) for r in desc.relations} >= {"behind(mouse_pad, mouse)", "right_of(cup, mouse_pad)"}
+    desc, _ = describe("a red block and a blue block, the red block left of the blue block")
+    assert [o.name for o in desc.objects] == ["red_block", "blue_block"]
+    assert "left_of(red_block, blue_block)" in {str(r) for r in desc.relations}
+    desc, _ = describe("a mug next to a mug")  # no "the": two mugs
+    assert [o.type for o in desc.objects] == ["mug", "mug"]
+
+
+def test_a_list_of_objects_is_the_scene_and_pairs_only_what_goes_together() -> None:
+    desc, source = describe("an apple, a bowl and a book")
+    assert source.kind == "mentions" and [o.type for o in desc.objects] == ["apple", "bowl", "book"]
+    assert "inside(apple, bowl)" in {str(r) for r in desc.relations}
+    desc, _ = describe("a mug to the left of a mouse pad and a mouse")
+    kinds = {str(r) for r in desc.relations}
+    assert "on(mouse, mouse_pad)" in kinds and not any("mouse, mug" in k for k in kinds)  # never in a mug
+    _, source = describe("tidy the desk with the mouse")  # one object named: the goal, with it
+    assert source.kind == "goal:tidy_the_desk"

@@ -49,7 +49,7 @@ def errors(view: TopView, empty: np.ndarray, preset: str) -> tuple[dict, object]
 
 
 @pytest.mark.parametrize(("preset", "position", "yaw"), [("none", 0.004, 4.0), ("jpeg", 0.006, 5.0),
-                                                         ("shift", 0.012, 6.0)])
+                                                         ("color", 0.005, 5.0), ("shift", 0.012, 6.0)])
 def test_matching_recovers_the_compositor_ground_truth(scene, preset: str, position: float,
                                                        yaw: float) -> None:
     _, view, empty = scene

@@ -8,7 +8,9 @@ Modules: ``messages`` (Message, PNG encoding), ``config`` (BackendConfig), ``usa
 ``retry`` (Failure, Retry-After, the retry loop, the circuit breaker), ``base`` (ChatBackend: chat,
 preflight, reset), ``providers`` (the one
 provider registry, ``connect``), ``builtin`` (registers openai and gemini), and one module per
-provider's SDK (``openai_compat``, ``gemini``).
+provider's SDK (``openai_compat``, ``gemini``). Image editing: ``images`` (ImageEditBackend,
+ImageAnswer, ``connect_images``) with ``gemini_images`` (``generateContent``) and ``openai_images``
+(any OpenAI-compatible ``/images/edits``), imported when first used.
 """
 
 from vcage.backends import builtin  # noqa: F401  registers the built-in providers

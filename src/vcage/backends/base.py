@@ -113,8 +113,9 @@ class ChatBackend(ABC):
         model = self.config.model
         return model in served or (":" not in model and f"{model}:latest" in served)  # Ollama's tags
 
-    def _send(self, request: Callable[[], T]) -> T:
-        """``request()`` with retries, behind the circuit breaker."""
+    def _send(self, request: Callable[[], T], *, what: str = "chat request", url: str | None = None) -> T:
+        """``request()`` with retries, behind the circuit breaker; ``what`` and ``url`` name the
+        request in errors (default: a chat request to :attr:`endpoint`)."""
         opened_by = self.breaker.check()
         if opened_by is not None:
             cfg = self.config
@@ -123,7 +124,8 @@ class ChatBackend(ABC):
                 f"(no request sent; fix the endpoint, then call reset() on the backend)",
                 endpoint=self.endpoint, model=cfg.model, status=getattr(opened_by, "status", None))
         try:
-            result = call_with_retries(request, self.config, classify=self._failure, give_up=self._error,
+            result = call_with_retries(request, self.config, classify=self._failure,
+                                       give_up=lambda f, n: self._error(f, n, what=what, url=url),
                                        count=self._count)
         except BackendError as exc:
             self.breaker.failure(exc)

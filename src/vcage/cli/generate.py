@@ -18,6 +18,7 @@ from vcage.errors import ConfigError
 
 if TYPE_CHECKING:
     from vcage.pipeline.config import GenerateConfig
+    from vcage.planning.schema import Plan
 
 
 @app.command("generate")
@@ -58,6 +59,9 @@ def generate_cmd(
         size: int = typer.Option(None, help="video width and height (even; default 128)"),
         workers: int = typer.Option(None, help="episodes attempted at once (one core each); the "
                                     "dataset is the same for any number"),
+        scene: Path = typer.Option(None, help="a synthesized scene (`vcage synthesize ... --out DIR`: "
+                                   "DIR or DIR/scene.json) the episodes start from; the dataset "
+                                   "records it and where it came from"),
         executor: str = typer.Option(None, help="local (this machine: processes) or ray"),
         address: str = typer.Option(None, help="with --executor ray: a running cluster's address "
                                     "(e.g. auto); default: start Ray locally")) -> None:
@@ -83,6 +87,8 @@ def generate_cmd(
     cfg = cfg.resolved()
     warn_if_oversubscribed(cfg.executor.name, cfg.executor.workers)
     plan = make_planner(cfg.planner).plan(instruction)  # before any progress is shown
+    if scene is not None or cfg.synthesized is not None:
+        plan, cfg = on_synthesized_scene(plan, cfg, scene)
     bar = Progress(TextColumn("{task.description}"), BarColumn(),
                    TextColumn("{task.completed}/{task.total}"), TimeElapsedColumn(), console=console)
     job = None
@@ -154,6 +160,19 @@ def build_config(path: Path | None, mode: str, options: dict[tuple[str, ...], An
             else:
                 tree[part]["backend"] = BackendConfig.from_env(prefix, None, **given).to_dict()
     return GenerateConfig.from_dict(tree)
+
+
+def on_synthesized_scene(plan: Plan, cfg: GenerateConfig, path: Path | None) -> tuple[Plan, GenerateConfig]:
+    """The plan bound to the synthesized scene in ``path`` (else the one ``cfg`` already holds, e.g.
+    from a dataset's meta/vcage.json), and ``cfg`` recording that scene."""
+    from dataclasses import replace
+
+    from vcage.synthesis.scene_file import ground_plan, load_scene
+
+    synthesized = load_scene(path) if path is not None else cfg.synthesized
+    assert synthesized is not None
+    plan, synthesized = ground_plan(plan, synthesized)
+    return plan, replace(cfg, synthesized=synthesized)
 
 
 def cores_available() -> int:

@@ -22,6 +22,7 @@ from vcage.critics.vlm import ENV_PREFIX as VLM_ENV_PREFIX
 from vcage.errors import ConfigError
 from vcage.planning import LLM_ENV_PREFIX, PlannerConfig
 from vcage.scene.instantiate import SceneConfig
+from vcage.synthesis.scene_file import SynthesizedScene
 
 SEED_LIMIT = 2**32  # seeds are unsigned 32-bit, as numpy's SeedSequence entropy
 # how a backend is reached, not what it answers: not compared when appending to a dataset
@@ -67,6 +68,9 @@ class GenerateConfig:
     sim: SimConfig = field(default_factory=SimConfig)
     randomization: Randomization = field(default_factory=Randomization)
     executor: ExecutorConfig = field(default_factory=ExecutorConfig)
+    # a synthesized scene (`vcage synthesize`) the episodes start from, with its provenance; None:
+    # the plan's objects are placed afresh. Stored only when set, so runs without one are unchanged
+    synthesized: SynthesizedScene | None = None
 
     def __post_init__(self) -> None:
         seed = self.seed
@@ -99,11 +103,14 @@ class GenerateConfig:
         return cfg
 
     def to_dict(self) -> dict[str, Any]:
-        return {"seed": self.seed, "max_attempts": self.max_attempts,
+        data = {"seed": self.seed, "max_attempts": self.max_attempts,
                 "planner": self.planner.to_dict(), "scene": self.scene.to_dict(),
                 "critic": self.critic.to_dict() if self.critic else None,
                 "render": self.render.to_dict(), "sim": self.sim.to_dict(),
                 "randomization": self.randomization.to_dict(), "executor": self.executor.to_dict()}
+        if self.synthesized is not None:
+            data["synthesized"] = self.synthesized.to_dict()
+        return data
 
     def data_dict(self) -> dict[str, Any]:
         """What must match to append to a dataset: everything but where episodes ran and how
@@ -120,7 +127,7 @@ class GenerateConfig:
     def from_dict(cls, data: dict[str, Any]) -> GenerateConfig:
         return from_fields(cls, data, planner=PlannerConfig, scene=SceneConfig, critic=CriticConfig,
                            render=RenderConfig, sim=SimConfig, randomization=Randomization,
-                           executor=ExecutorConfig)
+                           executor=ExecutorConfig, synthesized=SynthesizedScene)
 
     def episode_seed(self, episode: int, attempt: int) -> int:
         """The seed of an attempt: derived from the run seed, the episode and the attempt index."""

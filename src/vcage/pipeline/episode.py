@@ -108,7 +108,7 @@ def _attempt(plan: Plan, seed: int, cfg: GenerateConfig, critic: Critic | None, 
     clock = time.perf_counter
     t0 = clock()
     rng = np.random.default_rng(seed)
-    layout = plan_layout(plan, rng, cfg.randomization, cfg.scene.clutter)
+    layout = plan_layout(plan, rng, cfg.randomization, cfg.scene.clutter, scene=cfg.synthesized)
     instantiator = Instantiator(cfg.scene, cfg.sim, reach_map())
     try:
         spec, stats = instantiator.place(layout, rng)

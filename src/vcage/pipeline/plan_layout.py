@@ -7,6 +7,8 @@ clutter never occupies them.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from vcage.assets.catalog import CATALOG
@@ -22,6 +24,7 @@ from vcage.scene.layout import (
     Support,
 )
 from vcage.scene.randomize import environment, object_look
+from vcage.synthesis.scene_file import PlacedObject, SynthesizedScene
 
 # x 0.45..0.70, y -0.3..0.3 (metres): reachable for every skill, and clear of the arm's home pose
 # in the top view, so that the critic sees the objects after each subtask
@@ -30,16 +33,22 @@ TARGET_ZONE = 0.05  # half size of the zone kept free around a position target
 
 
 def plan_layout(plan: Plan, rng: np.random.Generator, rand: Randomization, clutter: int = 0,
-                work_area: Region = WORK_AREA) -> LayoutSpec:
+                work_area: Region = WORK_AREA, scene: SynthesizedScene | None = None) -> LayoutSpec:
+    """The plan's layout; with a synthesized ``scene`` (its objects named as the plan's, see
+    :func:`~vcage.synthesis.scene_file.ground_plan`) each object on the table starts at its pose
+    there, jittered by ``rand`` like a task's nominal item, instead of anywhere in ``work_area``."""
     objects = []
     for o in _largest_first(plan):
         scale, color, friction = object_look(o.type, rng, rand, (o.color,) if o.color else None)
         if o.scale is not None:
             scale = o.scale
         support = Support(o.on) if o.on else Support()
-        objects.append(LayoutObject(o.name, o.type, support=support,
-                                    region=None if o.on else work_area, scale=scale, color=color,
-                                    friction=friction))
+        region, yaw = None if o.on else work_area, (-math.pi, math.pi)
+        placed = scene.object(o.name) if scene is not None and not o.on else None
+        if placed is not None:
+            region, yaw = _nominal(placed, rand)
+        objects.append(LayoutObject(o.name, o.type, support=support, region=region, yaw=yaw, scale=scale,
+                                    color=color, friction=friction))
     relations = tuple(Relation(r.kind, r.a, r.b, r.distance) for r in plan.relations)
     reserved = tuple(
         ReservedZone(f"subtask{i}", Region((float(st.args["xy"][0]), float(st.args["xy"][1])),
@@ -47,6 +56,17 @@ def plan_layout(plan: Plan, rng: np.random.Generator, rand: Randomization, clutt
         for i, st in enumerate(plan.subtasks) if st.args.get("xy") is not None)
     return LayoutSpec(objects=tuple(objects), relations=relations, reserved=reserved,
                       distractors=Distractors(clutter), **environment(rng, rand))
+
+
+def _nominal(placed: PlacedObject, rand: Randomization) -> tuple[Region, tuple[float, float]]:
+    """The region and yaw range of an object at a nominal pose, as :func:`tasks.items.task_layout`
+    jitters its items."""
+    if not rand.enabled:
+        return Region((placed.x, placed.y)), (placed.yaw, placed.yaw)
+    lo, hi = rand.object_xy.low, rand.object_xy.high
+    mid = (lo + hi) / 2
+    region = Region((placed.x + mid, placed.y + mid), ((hi - lo) / 2, (hi - lo) / 2))
+    return region, (placed.yaw + rand.object_yaw.low, placed.yaw + rand.object_yaw.high)
 
 
 def _largest_first(plan: Plan) -> list[PlanObject]:

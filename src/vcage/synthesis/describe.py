@@ -1,8 +1,9 @@
 """The offline scene describer: a prompt to a :class:`SceneDescription` without any model.
 
 Objects come, in this order of preference, from the catalog objects the prompt names (with the
-relations it states between them, "the apple in the bowl"), from the best-matching goal of the
-planner's library (its objects; its subtasks' ``on`` / ``inside`` goals become relations), or from
+relations it states between them, "the apple in the bowl"; a list of two or more objects is taken
+as it is), from the best-matching goal of the planner's library (its objects; its subtasks'
+``on`` / ``inside`` goals become relations; an object the prompt names joins them), or from
 retrieval over the catalog. :mod:`vcage.synthesis.templates` arranges what the prompt leaves free.
 """
 
@@ -12,6 +13,7 @@ from dataclasses import dataclass
 
 from vcage.planning.goals import GOALS, Goal
 from vcage.planning.language import bounded
+from vcage.planning.lexicon import Mention
 from vcage.planning.offline import OfflinePlanner
 from vcage.synthesis.description import MAX_OBJECTS, SceneDescription, SceneObject, SceneRelation
 from vcage.synthesis.description import parse_description as _parse
@@ -22,6 +24,7 @@ from vcage.synthesis.templates import image_text, pairing, row
 
 GOAL_THRESHOLD = 0.25  # a goal this similar to the prompt lends its objects and relations
 MAX_RETRIEVED = 4  # objects a scene takes from retrieval alone
+LIST_OF_OBJECTS = 2  # a prompt naming this many objects and no relation is taken as the list of them
 MIN_RETRIEVED_SCORE = 0.02  # fused score a retrieved type needs to join a scene (about rank <= 20 in both)
 
 
@@ -53,16 +56,35 @@ def _from_goal(goal: Goal) -> tuple[list[SceneObject], list[SceneRelation]]:
 
 
 def _from_mentions(text: str) -> tuple[list[SceneObject], list[SceneRelation]]:
+    """One object per mention, except that "the X" after an X names that X again ("a mouse pad
+    behind a mouse, a cup right of the mouse pad" has one mouse pad)."""
     ws, mentions = lexicon_mentions(text)
     objects: list[SceneObject] = []
+    which: list[int] = []  # mention -> object
     for m in mentions:
         color = m.colours[0] if len(m.colours) == 1 else None
+        again = _antecedent(ws, m, mentions[:len(which)], which, objects)
+        if again is not None:
+            which.append(again)
+            continue
         base = f"{color}_{m.type}" if color else m.type
         objects.append(SceneObject(name=_unique([o.name for o in objects], base), type=m.type, color=color,
                                    scale=m.size or 1.0))
-    relations = [SceneRelation(kind=r.kind, a=objects[r.a].name, b=objects[r.b].name)  # type: ignore[arg-type]
-                 for r in explicit_relations(ws, mentions)]
+        which.append(len(objects) - 1)
+    relations = [SceneRelation(kind=r.kind, a=objects[which[r.a]].name,  # type: ignore[arg-type]
+                               b=objects[which[r.b]].name)
+                 for r in explicit_relations(ws, mentions) if which[r.a] != which[r.b]]
     return objects, relations
+
+
+def _antecedent(ws: list[str], m: Mention, before: list[Mention], which: list[int],
+                objects: list[SceneObject]) -> int | None:
+    """The object an earlier mention made that the definite ``m`` names again, if exactly one fits."""
+    if m.first <= 0 or ws[m.first - 1] != "the" or m.plural:
+        return None
+    fits = {which[k] for k, e in enumerate(before)
+            if e.type == m.type and (not m.colours or objects[which[k]].color in m.colours)}
+    return fits.pop() if len(fits) == 1 else None
 
 
 def best_goal(text: str) -> tuple[Goal, float] | None:
@@ -78,7 +100,7 @@ def describe(prompt: str, retrieval: Retrieval | None = None) -> tuple[SceneDesc
     text = check_prompt(prompt)
     objects, relations = _from_mentions(text)
     source = Source("mentions")
-    if not relations:
+    if not relations and len(objects) < LIST_OF_OBJECTS:  # "a mug, a plate and a book" is the scene
         goal = best_goal(text)
         if goal is not None:
             g_objects, g_relations = _from_goal(goal[0])

@@ -1,7 +1,7 @@
 """Template matching and 2D -> 3D: find each object of ``I_init`` in ``I_goal`` (the only OpenCV import).
 
 1. **Register** ``I_goal`` to ``I_init`` globally (a scale sweep, each scale's shift by phase
-   correlation of edges, the scale whose aligned goal differs least from the empty table on the
+   correlation of edges, the scale whose aligned edges differ least from the empty table's on the
    pixels that show no object in ``I_init``), undo that transform, and match the colour statistics.
 2. **Match** each object: its pixels (and a faint ring of the empty table around them) turned about
    its origin, matched by masked squared difference over yaw, coarse (half resolution, 10 degree
@@ -86,13 +86,16 @@ def _edges(image: np.ndarray) -> np.ndarray:
 
 def register(empty: np.ndarray, goal: np.ndarray, mask: np.ndarray) -> tuple[np.ndarray, bool]:
     """The similarity (2x3: I_init pixel -> I_goal pixel) that best aligns the goal's edges with the
-    empty table's: a scale sweep, each scale's shift by phase correlation, the strongest peak kept.
-    ``mask`` marks the pixels that show no object in I_init (only they are compared)."""
+    empty table's: a scale sweep, each scale's shift by phase correlation; kept is the scale whose
+    aligned edges, each map divided by its mean, differ least from the empty table's (edges: a colour
+    cast or JPEG noise is no misalignment). ``mask`` marks the pixels that show no object in I_init
+    (only they are compared)."""
     h, w = empty.shape[:2]
     centre = ((w - 1) / 2, (h - 1) / 2)
     ref = _edges(empty) * mask.astype(np.float32)
     edges = _edges(goal)
     window = cv2.createHanningWindow((w, h), cv2.CV_32F)
+    plain = ref[mask] / (ref[mask].mean() + 1e-6)
     best: tuple[float, np.ndarray, float] | None = None
     for scale in np.arange(1 - SCALE_SPAN, 1 + SCALE_SPAN + 1e-9, SCALE_STEP):
         m = cv2.getRotationMatrix2D(centre, 0.0, float(scale))  # init pixel -> goal pixel at this scale
@@ -100,8 +103,8 @@ def register(empty: np.ndarray, goal: np.ndarray, mask: np.ndarray) -> tuple[np.
         (dx, dy), response = cv2.phaseCorrelate(ref, back * mask.astype(np.float32), window)
         warp = m.copy()
         warp[:, 2] += np.array([dx * scale, dy * scale])
-        diff = np.abs(_unwarp(goal, warp).astype(np.float32) - empty.astype(np.float32)).sum(-1)[mask]
-        error = float(np.percentile(diff, 60))  # robust to the pixels the goal's objects cover
+        moved = _unwarp(edges, warp)[mask]
+        error = float(np.abs(moved / (moved.mean() + 1e-6) - plain).mean())  # edges: no colour cast
         if best is None or error < best[0]:
             best = (error, warp, float(response))
     assert best is not None

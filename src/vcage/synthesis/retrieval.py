@@ -16,14 +16,14 @@ from typing import Literal
 from vcage.assets.catalog import CATALOG, ObjectType
 from vcage.errors import ConfigError
 from vcage.synthesis.bm25 import BM25
-from vcage.synthesis.text import char_ngrams, content, expand, tokens
+from vcage.synthesis.text import GENERIC_STEMS, char_ngrams, content, expand, misspells, tokens
 from vcage.synthesis.tfidf import CharTfidf
 
 Affordance = Literal["grasp", "support", "container", "placement", "functional"]
 AFFORDANCES: tuple[str, ...] = ("grasp", "support", "container", "placement", "functional")
 RRF_K = 60  # reciprocal rank fusion constant (Cormack et al.)
 NAME_REPEAT = 3  # a type's own name words count this many times in its document
-TYPO_COSINE = 0.45  # without a shared word, an n-gram cosine this high still counts (a misspelling)
+TYPO_COSINE = 0.3  # without a shared word: a misspelling of one of its words, at least this n-gram cosine
 MIN_COSINE = 0.1  # below this the n-gram ranking does not vote for a type
 
 
@@ -97,6 +97,7 @@ class Retriever:
     def __init__(self, types: list[ObjectType] | None = None) -> None:
         self.types = list(types) if types is not None else list(CATALOG.values())
         docs = [document(t) for t in self.types]
+        self.words = [frozenset(tokens(d)) for d in docs]
         self.bm25 = BM25([tokens(d) for d in docs])
         self.tfidf = CharTfidf([char_ngrams(d) for d in docs])
 
@@ -107,11 +108,17 @@ class Retriever:
         if not content(query):
             return Retrieval(query, no_match="the request names no object (only stop words or generic "
                                              "words such as 'thing')", filters=require)
-        weights = {t: w for t, w in expand(query).items() if t in self.bm25.vocabulary}
+        weights = {t: w for t, w in expand(query).items()  # generic words ("pair", "top") say nothing
+                   if t in self.bm25.vocabulary and t not in GENERIC_STEMS}
         bm = self.bm25.scores(weights) if weights else [0.0] * len(self.types)
         cos = self.tfidf.scores(char_ngrams(" ".join(content(query))))
+        unknown = [w for w in content(query) if w not in self.bm25.vocabulary]
+
+        def typo(i: int) -> bool:  # found by n-grams alone: only as a misspelling of its words
+            return cos[i] >= TYPO_COSINE and any(misspells(w, self.words[i]) for w in unknown)
+
         keep = [i for i, t in enumerate(self.types)
-                if all(affords(t, n) for n in require) and (bm[i] > 0 or cos[i] >= TYPO_COSINE)]
+                if all(affords(t, n) for n in require) and (bm[i] > 0 or typo(i))]
         if not keep:
             why = ("no catalog type affords " + ", ".join(require)) if require and (
                 any(b > 0 for b in bm) or max(cos) >= TYPO_COSINE) else "no catalog type matches its words"

@@ -72,4 +72,5 @@ GENERIC = frozenset("""
 object objects thing things item items stuff something anything please put place move set
 arrange organize organise tidy clean get make bring take give find want need some any small big
 large little one two three table tabletop scene top left right front behind near next
+pair pairs piece pieces bunch couple
 """.split())  # noqa: SIM905

@@ -1,7 +1,8 @@
 """Relation templates: the arrangement an offline description gives objects the prompt leaves free.
 
 Two templates, applied in order: **pairing** rests each graspable object that has no support on a
-free host of the scene that fits it (a container's inside first, then a surface), and **row** lines
+free host of the scene that fits it and goes with it (a container's inside first, then a surface;
+a fruit into a bowl, never a mouse into a mug), and **row** lines
 the groups standing on the table up from left to right (``left_of`` and ``aligned`` between
 neighbours) when they fit in :data:`ROW_SPAN`.
 """
@@ -27,6 +28,25 @@ def _fits(child: SceneObject, host: SceneObject, kind: str) -> bool:
     return ours[0] <= limit * theirs[0] and ours[1] <= limit * theirs[1]
 
 
+# what kind of place an object belongs to, from its catalog tags and category; a host of a domain
+# takes objects of a domain that goes with it (a fruit into a bowl, a mouse onto a mouse pad), a
+# host of none (a basket, a box) takes anything, and an object of none goes onto any host
+DOMAINS = frozenset({"kitchen", "tableware", "food", "office", "electronics", "toy", "household"})
+GOES_WITH = {"food": {"kitchen", "tableware", "food"}, "kitchen": {"kitchen", "tableware", "food"},
+             "tableware": {"kitchen", "tableware", "food"}, "office": {"office", "electronics"},
+             "electronics": {"office", "electronics"}, "toy": {"toy"}, "household": {"household"}}
+
+
+def domains(o: SceneObject) -> set[str]:
+    t = CATALOG.get(o.type)
+    return (set(t.tags) | {t.category}) & DOMAINS
+
+
+def goes_with(child: SceneObject, host: SceneObject) -> bool:
+    mine, theirs = domains(child), domains(host)
+    return not mine or not theirs or any(theirs & GOES_WITH[d] for d in mine)
+
+
 def pairing(objects: tuple[SceneObject, ...], relations: list[SceneRelation]) -> list[SceneRelation]:
     """Support relations for graspable objects without one, one object per host."""
     supported = {r.a for r in relations if r.kind in ("on", "inside")}
@@ -42,7 +62,7 @@ def pairing(objects: tuple[SceneObject, ...], relations: list[SceneRelation]) ->
         for kind, word in (("in", "inside"), ("on", "on")):
             host = next((h for h in objects if h.name not in used and h.name != child.name
                          and h.name not in supported and frozenset((child.name, h.name)) not in paired
-                         and _fits(child, h, kind)), None)
+                         and _fits(child, h, kind) and goes_with(child, h)), None)
             if host is not None:
                 out.append(SceneRelation(kind=word, a=child.name, b=host.name))  # type: ignore[arg-type]
                 used.add(host.name)

@@ -89,3 +89,26 @@ def char_ngrams(text: str, n: tuple[int, ...] = (3, 4)) -> list[str]:
         for k in n:
             out.extend(padded[i:i + k] for i in range(max(1, len(padded) - k + 1)))
     return out
+
+
+def edit_distance(a: str, b: str, limit: int) -> int:
+    """Levenshtein distance of ``a`` and ``b``, or ``limit + 1`` once it is known to exceed ``limit``."""
+    if abs(len(a) - len(b)) > limit:
+        return limit + 1
+    row = list(range(len(b) + 1))
+    for i, ca in enumerate(a, 1):
+        prev, row[0] = row[0], i
+        best = row[0]
+        for j, cb in enumerate(b, 1):
+            prev, row[j] = row[j], min(row[j] + 1, row[j - 1] + 1, prev + (ca != cb))
+            best = min(best, row[j])
+        if best > limit:
+            return limit + 1
+    return row[-1]
+
+
+def misspells(word: str, vocabulary: Iterable[str]) -> bool:
+    """Whether ``word`` is a misspelling of a vocabulary word: within one edit per four letters (at
+    least one), so "bananna" is banana but "pineapple" is not apple nor "keyboard" board."""
+    limit = max(1, len(word) // 4)
+    return any(edit_distance(word, v, limit) <= limit for v in vocabulary)
