@@ -8,6 +8,7 @@ import math
 
 import numpy as np
 import pytest
+import shapely
 
 from vcage.config import Randomization
 from vcage.scene.instantiate import SceneConfig
@@ -38,8 +39,8 @@ def _violations(scene, cfg: PlacementConfig) -> list[tuple[str, str]]:
         if b.name not in task:
             continue
         zone = grasp_zone(b.type, b.scale, b.yaw, b.xy, cfg.finger_slack)
-        assert zone is not None
-        if footprint(a.type, a.scale, a.yaw, a.xy).intersects(zone):
+        assert zone
+        if any(footprint(a.type, a.scale, a.yaw, a.xy).intersects(piece) for piece in zone):
             out.append((a.name, b.name))
     return out
 
@@ -56,15 +57,36 @@ def test_no_footprint_stands_where_fingers_grasp_a_task_object(reach):
     assert before > 0  # the same layouts without zones do block grasps: the check above can fail
 
 
-def test_zone_covers_the_footprint_and_both_fingers():
-    zone = grasp_zone("mouse", 1.0, 0.0, (0.5, 0.1))
-    assert zone is not None and zone.covers(footprint("mouse", 1.0, 0.0, (0.5, 0.1)))
-    # the mouse is grasped across its width (y): the zone reaches the open fingers' outer faces
-    _, y0, _, y1 = zone.bounds
+def test_zones_are_the_open_fingers_of_each_grasp():
+    # the mouse is grasped across its width (y), from either side: one box, to the fingers' outer faces
+    (zone,) = grasp_zone("mouse", 1.0, 0.0, (0.5, 0.1))
+    x0, y0, x1, y1 = zone.bounds
     assert y1 - 0.1 == pytest.approx(R.FINGER_OUTER) and 0.1 - y0 == pytest.approx(R.FINGER_OUTER)
-    turned = grasp_zone("mouse", 1.0, math.pi / 2, (0.5, 0.1))
-    assert turned is not None and turned.bounds[2] - 0.5 == pytest.approx(R.FINGER_OUTER)
-    assert grasp_zone("mouse_pad", 1.0, 0.0) is None  # nothing grasps a pad
+    assert x1 - 0.5 == pytest.approx(R.FINGER_HALF_WIDTH) and 0.5 - x0 == pytest.approx(R.FINGER_HALF_WIDTH)
+    (turned,) = grasp_zone("mouse", 1.0, math.pi / 2, (0.5, 0.1))
+    assert turned.bounds[2] - 0.5 == pytest.approx(R.FINGER_OUTER)
+    assert len(grasp_zone("block", 1.0, 0.0)) == 2  # two grasps a quarter turn apart
+    assert grasp_zone("mouse_pad", 1.0, 0.0) == ()  # nothing grasps a pad
+
+
+def test_only_objects_the_plan_grasps_keep_zones(reach):
+    cfg = PlacementConfig()
+    target = LayoutObject("bowl", "bowl", region=AREA, grasped=False)  # a target: rim grasps unused
+    mouse = LayoutObject("mouse", "mouse", region=AREA)
+    hits = 0
+    for seed in range(6):
+        scene = place(LayoutSpec(objects=(target, mouse), distractors=Distractors(8)),
+                      np.random.default_rng(seed), config=cfg, reach=reach).scene
+        pose = {o.name: o for o in scene.objects}
+        bowl_zone = grasp_zone("bowl", pose["bowl"].scale, pose["bowl"].yaw, pose["bowl"].xy)
+        others = [footprint(o.type, o.scale, o.yaw, o.xy) for o in scene.objects if o.name != "bowl"]
+        hits += sum(any(f.intersects(z) for z in bowl_zone) for f in others)
+        m = pose["mouse"]
+        for o in scene.objects:
+            if o.name != "mouse":
+                assert not any(footprint(o.type, o.scale, o.yaw, o.xy).intersects(z)
+                               for z in grasp_zone("mouse", m.scale, m.yaw, m.xy, cfg.finger_slack))
+    assert hits > 0  # the bowl's unused zones were not kept free
 
 
 def test_finger_box_constants_match_the_robot_model():
@@ -95,3 +117,46 @@ def test_configs_stored_before_finger_zones_keep_placing_without_them():
     scene = SceneConfig.from_dict({"clutter": 2, "placement_config": old})
     assert scene.placement_config.finger_zones is False
     assert SceneConfig.from_dict(SceneConfig().to_dict()) == SceneConfig()
+
+
+def test_a_plans_layout_marks_what_its_subtasks_grasp():
+    from vcage.pipeline.plan_layout import plan_layout
+    from vcage.planning import make_planner
+    from vcage.planning.config import PlannerConfig
+
+    plan = make_planner(PlannerConfig()).plan("prepare breakfast")
+    layout = plan_layout(plan, np.random.default_rng(0), Randomization())
+    grasped = {o.name for o in layout.objects if o.grasped}
+    picked = {st.args["obj"] for st in plan.subtasks if st.skill == "pick_and_place"}
+    assert grasped == picked and len(picked) >= 2
+    assert len(grasped) < len(layout.objects)  # the basket, the coaster, the bell are not grasped
+
+
+def test_what_a_target_receives_finds_room_there(reach):
+    from vcage.pipeline.plan_layout import plan_layout
+    from vcage.planning import make_planner
+    from vcage.planning.config import PlannerConfig
+    from vcage.scene.placement.geometry import carry_radius
+
+    plan = make_planner(PlannerConfig()).plan("prepare breakfast")
+    puts = {st.args["target"]: st.args["obj"] for st in plan.subtasks
+            if st.skill == "pick_and_place" and st.args.get("target")}
+    layout = plan_layout(plan, np.random.default_rng(0), Randomization())
+    by_name = {o.name: o for o in layout.objects}
+    assert puts and all(by_name[t].receives == pytest.approx(carry_radius(by_name[h].type, by_name[h].scale))
+                        for t, h in puts.items())
+    assert all(o.receives == 0 for o in layout.objects if o.name not in puts)
+    # a coaster that will receive a cup, packed among other things: nothing stands in that room
+    need = carry_radius("cup", 1.0)
+    coaster = LayoutObject("coaster", "coaster", region=AREA, receives=need)
+    crowd = (coaster, *(LayoutObject(f"b{i}", "block", region=AREA, grasped=False) for i in range(9)))
+    inside = {True: 0, False: 0}
+    for zones in (True, False):
+        for seed in range(6):
+            scene = place(LayoutSpec(objects=crowd), np.random.default_rng(seed),
+                          config=PlacementConfig(finger_zones=zones), reach=reach).scene
+            pose = {o.name: o for o in scene.objects}
+            room = shapely.Point(pose["coaster"].xy).buffer(need, 16)
+            inside[zones] += sum(footprint(o.type, o.scale, o.yaw, o.xy).intersects(room)
+                                 for o in scene.objects if o.name != "coaster")
+    assert inside[True] == 0 < inside[False]

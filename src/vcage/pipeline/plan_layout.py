@@ -1,8 +1,9 @@
 """The scene for a whole plan: its objects placed context-aware in the work area, plus clutter.
 
 Task objects go into :data:`WORK_AREA` (where the skills' experts are measured); distractors may
-go anywhere within reach. Targets given as positions (``xy`` arguments) become reserved zones, so
-clutter never occupies them.
+go anywhere within reach. Objects a subtask grasps keep their finger zones clear (see
+:class:`~vcage.scene.layout.LayoutObject`); targets and pressed objects need none. Targets given
+as positions (``xy`` arguments) become reserved zones, so clutter never occupies them.
 """
 
 from __future__ import annotations
@@ -23,6 +24,7 @@ from vcage.scene.layout import (
     ReservedZone,
     Support,
 )
+from vcage.scene.placement.geometry import carry_radius
 from vcage.scene.randomize import environment, object_look
 from vcage.synthesis.scene_file import PlacedObject, SynthesizedScene
 
@@ -30,6 +32,7 @@ from vcage.synthesis.scene_file import PlacedObject, SynthesizedScene
 # in the top view, so that the critic sees the objects after each subtask
 WORK_AREA = Region((0.575, 0.0), (0.125, 0.3))
 TARGET_ZONE = 0.05  # half size of the zone kept free around a position target
+GRASPING_SKILLS = ("pick_and_place", "grasp")  # plan skills whose ``obj`` the fingers close on
 
 
 def plan_layout(plan: Plan, rng: np.random.Generator, rand: Randomization, clutter: int = 0,
@@ -37,18 +40,32 @@ def plan_layout(plan: Plan, rng: np.random.Generator, rand: Randomization, clutt
     """The plan's layout; with a synthesized ``scene`` (its objects named as the plan's, see
     :func:`~vcage.synthesis.scene_file.ground_plan`) each object on the table starts at its pose
     there, jittered by ``rand`` like a task's nominal item, instead of anywhere in ``work_area``."""
-    objects = []
+    looks = {}
     for o in _largest_first(plan):
         scale, color, friction = object_look(o.type, rng, rand, (o.color,) if o.color else None)
-        if o.scale is not None:
-            scale = o.scale
+        looks[o.name] = (o.scale if o.scale is not None else scale, color, friction)
+    grasped = {str(st.args["obj"]) for st in plan.subtasks if st.skill in GRASPING_SKILLS}
+    types = {o.name: o.type for o in plan.objects}
+    receives: dict[str, tuple[float, str | None]] = {}
+    for st in plan.subtasks:  # what is put on or in a target needs room there, hand included
+        target = st.args.get("target")
+        if st.skill == "pick_and_place" and target is not None:
+            held = str(st.args["obj"])
+            room = carry_radius(types[held], looks[held][0])
+            receives[str(target)] = (max(room, receives.get(str(target), (0.0, None))[0]),
+                                     st.args.get("placement"))
+    objects = []
+    for o in _largest_first(plan):
+        scale, color, friction = looks[o.name]
         support = Support(o.on) if o.on else Support()
         region, yaw = None if o.on else work_area, (-math.pi, math.pi)
         placed = scene.object(o.name) if scene is not None and not o.on else None
         if placed is not None:
             region, yaw = _nominal(placed, rand)
         objects.append(LayoutObject(o.name, o.type, support=support, region=region, yaw=yaw, scale=scale,
-                                    color=color, friction=friction))
+                                    color=color, friction=friction, grasped=o.name in grasped,
+                                    receives=receives.get(o.name, (0.0, None))[0],
+                                    receives_at=receives.get(o.name, (0.0, None))[1]))
     relations = tuple(Relation(r.kind, r.a, r.b, r.distance) for r in plan.relations)
     reserved = tuple(
         ReservedZone(f"subtask{i}", Region((float(st.args["xy"][0]), float(st.args["xy"][1])),

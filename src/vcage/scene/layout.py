@@ -65,7 +65,12 @@ class LayoutObject:
     """One object to place. ``region`` confines its origin; ``yaw`` is the range yaw is drawn from.
 
     ``task`` objects are the ones a plan manipulates: distractors keep clear of them so that the
-    gripper can approach, and tall distractors keep further away.
+    gripper can approach, and tall distractors keep further away. ``grasped`` says whether the
+    robot will grasp a task object: context placement then keeps the ground its open fingers
+    sweep free (its finger zones); objects that are only targets or pressed need none.
+    ``receives`` is the radius kept free around the centre of the placement region ``receives_at``
+    (None: the first) of an object the robot will put something on or in: what the hand carries
+    there, fingers included.
     """
 
     name: str
@@ -77,6 +82,9 @@ class LayoutObject:
     color: str | None = None
     friction: float = 1.0
     task: bool = True
+    grasped: bool = True
+    receives: float = 0.0
+    receives_at: str | None = None
 
     def __post_init__(self) -> None:
         if self.yaw[0] > self.yaw[1]:

@@ -33,6 +33,7 @@ GRIPPER_OPEN = 0.04  # metres per finger
 # closing axis and FINGER_HALF_WIDTH across it. A neighbour inside it blocks a grasp's descent.
 FINGER_OUTER = 0.070
 FINGER_HALF_WIDTH = 0.022
+FINGER_THICKNESS = FINGER_OUTER - GRIPPER_OPEN  # beyond the pad: closed on w, the box reaches w/2 + this
 # A comfortable home posture with the hand pointing down above the table.
 HOME_QPOS = np.array([0.0, -0.5, 0.0, -2.4, 0.0, 0.35, 0.0])
 # Distance from link7's origin to the point midway between the finger pads.

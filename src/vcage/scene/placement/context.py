@@ -28,7 +28,14 @@ from vcage.errors import PlacementError
 from vcage.scene.layout import LayoutObject, LayoutSpec
 from vcage.scene.placement.base import PLACERS, PlacementStats, Placer, Pose, height, support_frame
 from vcage.scene.placement.free_space import Occupant, SurfaceMap
-from vcage.scene.placement.geometry import erode_box, footprint, grasp_zone, rotated_rect, sample_point
+from vcage.scene.placement.geometry import (
+    erode_box,
+    footprint,
+    grasp_zone,
+    rotated_rect,
+    sample_point,
+    to_world,
+)
 from vcage.scene.spec import ROBOT_MOUNT
 
 FAR = 10.0  # half-planes are boxes this large
@@ -171,18 +178,25 @@ class ContextAwarePlacer(Placer):
         distractor_tall = tall if occ.task else occ.tall
         return self.config.tall_clearance if distractor_tall else self.config.task_clearance
 
-    def _zone(self, obj: LayoutObject, yaw: float, xy: tuple[float, float]) -> Polygon | None:
-        """The finger zone of a task object standing on the table (None for the others)."""
+    def _zone(self, obj: LayoutObject, yaw: float, xy: tuple[float, float]) -> tuple[Polygon, ...]:
+        """The ground the hand needs around a task object on the table: its finger zones if the
+        robot grasps it, the room of what it carries there if it receives something."""
         if not (self.config.finger_zones and obj.task and obj.support.is_table):
-            return None
-        return grasp_zone(obj.type, obj.scale, yaw, xy, self.config.finger_slack)
+            return ()
+        slack = self.config.finger_slack
+        pieces = grasp_zone(obj.type, obj.scale, yaw, xy, slack) if obj.grasped else ()
+        if obj.receives > 0:
+            place = CATALOG.get(obj.type).placement(obj.receives_at)
+            center = to_world(xy, yaw, (place.pos[0] * obj.scale, place.pos[1] * obj.scale))
+            pieces += (Point(center).buffer(obj.receives + slack, 16),)
+        return pieces
 
     def _commit(self, obj: LayoutObject, pose: Pose) -> None:
         occ = Occupant(obj.name, footprint(obj.type, obj.scale, pose.yaw, pose.xy), obj.task,
                        height(obj) > self.config.tall_height, self._zone(obj, pose.yaw, pose.xy))
         self.maps["table"].add(occ)
         if not obj.support.is_table:
-            self.maps[obj.support.label()].add(replace(occ, zone=None))
+            self.maps[obj.support.label()].add(replace(occ, zone=()))
 
     def _uncommit(self, obj: LayoutObject) -> None:
         self.maps["table"].remove(obj.name)

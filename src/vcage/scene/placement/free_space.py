@@ -6,9 +6,10 @@ reserved zones). :meth:`SurfaceMap.free` returns the origins at which a new foot
 none of them: the domain minus the configuration-space obstacle of every prohibited region for
 that footprint. Sampling from it never needs blind rejection.
 
-An object the robot will grasp also carries a *finger zone* (:func:`.geometry.grasp_zone`): the
-ground its open fingers sweep on the way down. No footprint may lie in another object's zone, so
-a neighbour never blocks a grasp; two zones may overlap (the fingers go down one at a time).
+An object the robot will grasp also carries *finger zones* (:func:`.geometry.grasp_zone`): the
+ground its open fingers sweep on the way down to each of its grasps. No footprint may lie in
+another object's zone, so a neighbour never blocks a grasp; zones may overlap (the fingers go down
+one at a time).
 """
 
 from __future__ import annotations
@@ -26,13 +27,13 @@ from vcage.scene.placement.geometry import minkowski_cobstacle
 @dataclass(frozen=True)
 class Occupant:
     """A footprint on the surface; ``task`` and ``tall`` decide the clearance others keep;
-    ``zone`` is where the fingers go down to grasp it (None: it is not grasped)."""
+    ``zone`` is where the fingers go down to grasp it (convex pieces; empty: it is not grasped)."""
 
     name: str
     shape: Polygon
     task: bool = False
     tall: bool = False
-    zone: Polygon | None = None
+    zone: tuple[Polygon, ...] = ()
 
 
 # (occupant, new object's task flag, new object's tall flag) -> extra clearance in metres
@@ -57,7 +58,7 @@ class SurfaceMap:
         del self.occupants[name]
 
     def free(self, shape: Polygon, task: bool, tall: bool, clearance: Clearance,
-             domain: BaseGeometry, zone: Polygon | None = None) -> BaseGeometry:
+             domain: BaseGeometry, zone: tuple[Polygon, ...] = ()) -> BaseGeometry:
         """Origins in ``domain`` where ``shape`` (a footprint about the origin, already grown by
         the common margin) touches no occupant and no keep-out, and where no occupant's finger
         zone holds ``shape`` nor ``zone`` (the new object's, about its origin) any occupant."""
@@ -66,10 +67,8 @@ class SurfaceMap:
             extra = clearance(occ, task, tall)
             grown = occ.shape if extra <= 0 else occ.shape.buffer(extra, join_style="mitre")
             obstacles.append(minkowski_cobstacle(grown, shape))
-            if occ.zone is not None:
-                obstacles.append(minkowski_cobstacle(occ.zone, shape))
-            if zone is not None:
-                obstacles.append(minkowski_cobstacle(occ.shape, zone))
+            obstacles.extend(minkowski_cobstacle(piece, shape) for piece in occ.zone)
+            obstacles.extend(minkowski_cobstacle(occ.shape, piece) for piece in zone)
         if not obstacles or domain.is_empty:
             return domain
         return domain.difference(shapely.union_all(obstacles))

@@ -16,7 +16,7 @@ from shapely.geometry import MultiPoint, Point, Polygon
 from shapely.geometry.base import BaseGeometry
 
 from vcage.assets.catalog import CATALOG
-from vcage.sim.robot import FINGER_HALF_WIDTH, FINGER_OUTER
+from vcage.sim.robot import FINGER_HALF_WIDTH, FINGER_OUTER, FINGER_THICKNESS
 
 EMPTY = Polygon()
 Vec2 = Sequence[float] | np.ndarray  # an (x, y) pair
@@ -30,20 +30,31 @@ def footprint(type_name: str, scale: float, yaw: float, xy: tuple[float, float] 
 
 
 def grasp_zone(type_name: str, scale: float, yaw: float, xy: tuple[float, float] = (0.0, 0.0),
-               slack: float = 0.0) -> Polygon | None:
-    """Where the open fingers go down when ``type_name`` at ``xy`` and ``yaw`` is grasped: the
-    convex hull of its footprint and, for every annotated grasp, the open fingers' box (grown by
-    ``slack``). Another object's footprint inside it blocks that grasp. None without grasps."""
-    otype = CATALOG.get(type_name)
-    if not otype.grasps:
-        return None
-    boxes = [footprint(type_name, scale, yaw, xy)]
+               slack: float = 0.0) -> tuple[Polygon, ...]:
+    """Where the open fingers go down when ``type_name`` at ``xy`` and ``yaw`` is grasped: for
+    every annotated grasp (identical ones once), the box of the open fingers grown by ``slack``.
+    Another object's footprint in any of them blocks that grasp. Empty without grasps."""
     half = (FINGER_HALF_WIDTH + slack, FINGER_OUTER + slack)  # gripper x, closing axis
-    for g in otype.grasps:
+    boxes: list[Polygon] = []
+    for g in CATALOG.get(type_name).grasps:
         center = to_world(xy, yaw, (g.pos[0] * scale, g.pos[1] * scale))
-        boxes.append(rotated_rect(center, yaw + g.yaw, half))
-    hull = shapely.union_all(boxes).convex_hull
-    return hull if isinstance(hull, Polygon) else None
+        box = rotated_rect(center, yaw + g.yaw, half)
+        if not any(box.symmetric_difference(b).area < 1e-10 for b in boxes):  # e.g. yaw and yaw + pi
+            boxes.append(box)
+    return tuple(boxes)
+
+
+def carry_radius(type_name: str, scale: float) -> float:
+    """How far from its origin ``type_name`` held in the hand reaches, closed fingers included, for
+    the widest of its grasps: the room it needs where it is put down."""
+    otype = CATALOG.get(type_name)
+    sx, sy = (s * scale / 2 for s in otype.size[:2])
+    corners = [np.hypot(sx, sy)]
+    for g in otype.grasps:
+        box = rotated_rect((g.pos[0] * scale, g.pos[1] * scale), g.yaw,
+                           (FINGER_HALF_WIDTH, g.width * scale / 2 + FINGER_THICKNESS))
+        corners.extend(float(np.hypot(x, y)) for x, y in list(box.exterior.coords)[:-1])
+    return float(max(corners))
 
 
 def to_world(center: Vec2, yaw: float, local: Vec2) -> np.ndarray:
