@@ -7,9 +7,11 @@ rollout continues whatever it says, so each subtask gives one (critic, oracle) p
 skill could not plan are left out (no critic is asked about them in a run either). Episode k
 uses the seed of the first attempt at episode k in ``vcage_vs_vanilla``'s Vanilla run.
 
-Printed per goal and overall: judged subtasks, the oracle's failures among them, agreement,
-precision and recall of "accept" (as in ``vcage audit``), and the share of the oracle's failures the
-critic rejected (what keeps them out of a dataset).
+Printed per goal and overall, beside every figure, the sample it rests on: judged subtasks, the
+oracle's successes and failures among them, and the distinct scenes they come from; then
+agreement, precision and recall of "accept" (as in ``vcage audit``), the share of the oracle's
+failures the critic rejected (what keeps them out of a dataset) and balanced accuracy. A figure
+whose denominator is empty prints "n/a" (not 0%).
 
     LP_NUM_THREADS=1 .venv/bin/python benchmarks/critic_agreement.py --seeds 10 --workers 2
 
@@ -20,6 +22,8 @@ is the simplified meshes, as in a run).
 from __future__ import annotations
 
 import argparse
+import hashlib
+import json
 import os
 import time
 from concurrent.futures import ProcessPoolExecutor
@@ -41,7 +45,8 @@ class Shadow(Critic):
     """Asks ``inner`` and keeps its verdicts, but always lets the rollout go on."""
 
     def __init__(self, inner: Critic) -> None:
-        self.inner, self.verdicts = inner, []  # type: list[Verdict]
+        self.inner = inner
+        self.verdicts: list[Verdict] = []
         self.needs_views = inner.needs_views
 
     def judge(self, obs: Observation) -> Verdict:
@@ -49,7 +54,10 @@ class Shadow(Critic):
         return Verdict(True, "shadow: the rollout continues")
 
 
-def _run(job: tuple[str, int, str]) -> list[tuple[str, bool, bool]]:
+Row = tuple[str, str, bool, bool, str]  # goal, scene, critic accepts, oracle success, why
+
+
+def _run(job: tuple[str, int, str]) -> list[Row]:
     goal, episode, mesh_detail = job
     phrase = next(g for g in GOALS if g.name == goal).phrasings[0]
     plan = make_planner("offline").plan(phrase)
@@ -59,18 +67,26 @@ def _run(job: tuple[str, int, str]) -> list[tuple[str, bool, bool]]:
     result = attempt(plan, cfg.episode_seed(episode, 0), cfg, shadow)
     if result.rollout is None:
         return []
+    scene = hashlib.sha1(json.dumps(result.scene.to_dict() if result.scene else None, sort_keys=True,
+                                    default=str).encode()).hexdigest()[:12]
     judged = [o for o in result.rollout.outcomes if o.verdict is not None]
-    return [(goal, v.accept, o.oracle_success) for o, v in zip(judged, shadow.verdicts, strict=True)]
+    return [(goal, scene, v.accept, o.oracle_success, f"seed {episode} subtask {o.index + 1}: {v.reason}; "
+             f"oracle {o.oracle}") for o, v in zip(judged, shadow.verdicts, strict=True)]
 
 
-def _line(name: str, pairs: list[tuple[str, bool, bool]]) -> str:
-    tp = sum(c and o for _, c, o in pairs)
-    fp = sum(c and not o for _, c, o in pairs)
-    fn = sum(not c and o for _, c, o in pairs)
-    tn = sum(not c and not o for _, c, o in pairs)
-    n = len(pairs)
-    return (f"{name:24s} {n:6d} {tn + fp:8d} {(tp + tn) / max(1, n):7.1%} {tp / max(1, tp + fp):7.1%} "
-            f"{tp / max(1, tp + fn):7.1%} {tn / max(1, tn + fp):9.1%}")
+def _pct(num: int, den: int, width: int = 7) -> str:
+    return f"{num / den:{width}.1%}" if den else f"{'n/a':>{width}s}"
+
+
+def _line(name: str, pairs: list[Row]) -> str:
+    tp = sum(c and o for _, _, c, o, _ in pairs)
+    fp = sum(c and not o for _, _, c, o, _ in pairs)
+    fn = sum(not c and o for _, _, c, o, _ in pairs)
+    tn = sum(not c and not o for _, _, c, o, _ in pairs)
+    n, scenes = len(pairs), len({(g, s) for g, s, *_ in pairs})
+    bal = f"{(tp / (tp + fn) + tn / (tn + fp)) / 2:8.1%}" if tp + fn and tn + fp else f"{'n/a':>8s}"
+    return (f"{name:24s} {n:6d} {tp + fn:5d} {tn + fp:5d} {scenes:6d} {_pct(tp + tn, n)} {_pct(tp, tp + fp)} "
+            f"{_pct(tp, tp + fn)} {_pct(tn, tn + fp, 9)} {bal}")
 
 
 def main() -> None:
@@ -81,6 +97,7 @@ def main() -> None:
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--mesh-detail", choices=MESH_DETAILS, default=RenderConfig().mesh_detail,
                         help="how the critic's views draw the robot's meshes")
+    parser.add_argument("--show-errors", action="store_true", help="print each disagreement")
     args = parser.parse_args()
     jobs = [(g, s, args.mesh_detail) for g in args.goals for s in range(args.seeds)]
     t0 = time.perf_counter()
@@ -89,13 +106,18 @@ def main() -> None:
     print(f"image critic vs oracle on Vanilla rollouts (naive placement, no scene check), "
           f"{args.seeds} seeds per goal, every subtask judged, mesh detail {args.mesh_detail}; "
           f"{time.perf_counter() - t0:.0f} s wall\n")
-    print(f"{'goal':24s} {'judged':>6s} {'failures':>8s} {'agree':>7s} {'prec':>7s} {'recall':>7s} "
-          f"{'caught':>9s}")
+    print(f"{'goal':24s} {'judged':>6s} {'succ':>5s} {'fail':>5s} {'scenes':>6s} {'agree':>7s} {'prec':>7s} "
+          f"{'recall':>7s} {'caught':>9s} {'bal.acc':>8s}")
     for goal in args.goals:
         print(_line(goal, [p for p in pairs if p[0] == goal]))
     print(_line("overall", pairs))
-    print("\nfailures: subtasks the oracle says failed; prec/recall: of the critic's accepts; caught: "
-          "share of the oracle's failures the critic rejected")
+    print("\nsucc/fail: judged subtasks the oracle says succeeded / failed; scenes: distinct scenes they "
+          "come from; prec/recall: of the critic's accepts; caught: share of the oracle's failures the "
+          "critic rejected; bal.acc: mean of recall and caught; n/a: empty denominator")
+    if args.show_errors:
+        for goal, _, accept, success, why in pairs:
+            if accept != success:
+                print(f"  {'false accept' if accept else 'false reject'} {goal} {why}")
 
 
 if __name__ == "__main__":

@@ -18,6 +18,15 @@ class RejectAll(Critic):
         return Verdict(False, "rejects everything")
 
 
+class AcceptAll(Critic):
+    """Accepts every subtask: what the oracle says failed goes into the dataset (label noise)."""
+
+    needs_views = False
+
+    def judge(self, obs: Observation) -> Verdict:
+        return Verdict(True, "accepts everything")
+
+
 class Alternating(Critic):
     """Accepts, rejects, accepts, ... in call order: with one subtask and one attempt per episode,
     every second episode is given up."""
@@ -32,6 +41,6 @@ class Alternating(Critic):
         return Verdict(self.calls % 2 == 1, f"call {self.calls}")
 
 
-for _name, _cls in (("reject_all", RejectAll), ("alternating", Alternating)):
+for _name, _cls in (("reject_all", RejectAll), ("alternating", Alternating), ("accept_all", AcceptAll)):
     if _name not in CRITICS:  # several test modules import this one
         CRITICS.add(_name, lambda config, cls=_cls: cls())

@@ -1,16 +1,23 @@
 """The offline image critic: judges a subtask from rendered images and segmentation masks only.
 
-It never reads simulator state. Each predicate of the subtask is checked in image space:
+It sees what :mod:`vcage.pipeline.verifier` renders around the subtask: the orthographic top view
+(RGB and the renderer's segmentation masks, with its pixel size in metres) and the perspective front
+view (RGB, segmentation and depth), before the subtask, at its deepest moment (where the hand was
+lowest) and after the retreat. It never reads simulator state. Each predicate is checked in image
+space:
 
-- ``on(a, b)`` / ``inside(a, b)``: in the top view (orthographic) most of ``a``'s pixels lie in
-  the convex hull of ``b``'s (or, when ``a`` is the larger, ``b``'s in ``a``'s); in the front view
-  ``a`` rests on ``b``: its lowest pixel row lies within ``b``'s rows (for ``inside``, no lower than
-  ``b``'s bottom).
-- ``released(a)``: after the retreat, the robot does not touch ``a`` in both views (a projection
-  overlap in one view is not contact).
-- ``pressed(x)``: in the views at the subtask's deepest moment the robot touches ``x`` (front view)
-  and covers it (top view), and afterwards ``x`` is still where it was and upright.
-- ``upright(x)``: ``x``'s top-view area and front-view height are close to what they were before.
+- ``on(a, b)`` / ``inside(a, b)``: in the top view most of ``a``'s pixels lie in the convex hull of
+  ``b``'s outline (or, when ``a`` is the larger, ``b``'s in ``a``'s) and ``a``'s centre lies over
+  it; ``b``'s outline is its visible pixels plus its outline from before, moved to where it is now
+  (``a`` may hide ``b``, and both may have moved). In the front view ``a`` rests on ``b``: its
+  lowest pixel row lies within ``b``'s rows (for ``inside``, no lower than ``b``'s bottom).
+- ``released(a)``: after the retreat, the robot does not touch ``a`` in every view that shows it
+  (a projection overlap in one view is not contact); ``a`` hidden in every view is not released.
+- ``pressed(x)``: in the views at the subtask's deepest moment the robot touches ``x`` (front view,
+  at the same depth) and covers it (top view).
+- ``upright(x)``: ``x``'s top-view area (orthographic, so true to size wherever it stands) and the
+  spread of its outline are close to what they were before, allowing for what the robot can hide;
+  its front-view height did not drop.
 - ``on_table(a)``: released and not over another object in the top view.
 - ``left_of`` / ``right_of``: column order in the top view (+y, the robot's left, is image left).
 - ``near(a, b)``: the centroids of the two masks in the top view are within the oracle's 10 cm,
@@ -18,7 +25,9 @@ It never reads simulator state. Each predicate of the subtask is checked in imag
 - ``lifted(a)``: in the front view ``a``'s lowest row rose by at least :data:`LIFT_ROWS` pixels
   since before the subtask, and it is not over another object's top-view hull (it hangs in the air).
 
-Every predicate of :mod:`vcage.vocabulary` has a check in ``IMAGE_CHECKS``.
+Every predicate of :mod:`vcage.vocabulary` has a check in ``IMAGE_CHECKS``. Known blind spot: a
+press that touches the button but moves it less than its travel (a few millimetres, about one pixel
+of the front view) looks like a press.
 """
 
 from __future__ import annotations
@@ -26,21 +35,22 @@ from __future__ import annotations
 from collections.abc import Callable
 
 import numpy as np
-import shapely
-from shapely.geometry import MultiPoint
 
 from vcage.critics.base import CRITICS, Critic, CriticConfig, Observation, Verdict, View
+from vcage.critics.masks import TOUCH, best_shift, centroid_in, dilate, hull, rows_of, shift, spread, touch
 from vcage.registry import Registry
 
 ROBOT = -2
 TOP, FRONT = "top", "front"
 MIN_OVERLAP = 0.6  # share of the smaller region's pixels that must overlap the other's hull
+CENTRE_TOL = 2  # pixels (about 1 cm) by which an object's centre may lie outside its support's hull
+COVERED = 0.5  # share of its top-view area before below which an object counts as covered now
+STILL = 0.9  # share of an object's pixels within its outline before for it to count as not moved
 ROW_TOL = 3  # pixels of slack for row comparisons in the front view
-TOUCH = 2  # pixels: masks closer than this touch
-AREA_RATIO = (0.6, 1.6)  # top-view area after / before for an object that stayed upright
-HEIGHT_RATIO = 0.7  # front-view height after / before for an object that stayed upright
+AREA_RATIO = (0.8, 1.25)  # top-view (orthographic) area after / before of an object that stayed upright
+SHAPE_RATIO = 1.2  # top-view long-axis spread after / before (either way) of an object that stayed upright
+HEIGHT_RATIO = 0.8  # front-view height after / before for an object that stayed upright
 COL_MARGIN = 2  # pixels of column separation for left_of / right_of
-DEPTH_TOL = 0.02  # metres: adjacent pixels this close in depth are in contact
 NEAR = 0.1  # metres between the centroids for ``near`` (the oracle's distance)
 LIFT_ROWS = 8  # front-view pixel rows (of 240) an object's bottom must rise to count as lifted
 
@@ -67,45 +77,19 @@ def _mask(obs: Observation, view: View, name: str) -> np.ndarray:
     return view.segmentation == obs.labels.index(name)
 
 
-def _hull(mask: np.ndarray) -> np.ndarray:
-    """The filled convex hull of a mask's pixels."""
-    rows, cols = np.nonzero(mask)
-    if len(rows) < 3:
-        return mask.copy()
-    hull = MultiPoint(np.column_stack([cols, rows]).astype(float)).convex_hull.buffer(0.5)
-    r0, r1, c0, c1 = rows.min(), rows.max() + 1, cols.min(), cols.max() + 1
-    cc, rr = np.meshgrid(np.arange(c0, c1), np.arange(r0, r1))
-    out = np.zeros_like(mask)
-    out[r0:r1, c0:c1] = shapely.contains_xy(hull, cc.astype(float), rr.astype(float))
-    return out | mask
-
-
-def _dilate(mask: np.ndarray, px: int) -> np.ndarray:
-    out = mask.copy()
-    for _ in range(px):
-        grown = out.copy()
-        grown[1:] |= out[:-1]
-        grown[:-1] |= out[1:]
-        grown[:, 1:] |= out[:, :-1]
-        grown[:, :-1] |= out[:, 1:]
-        out = grown
-    return out
-
-
-def _touch(a: np.ndarray, b: np.ndarray, depth: np.ndarray | None = None) -> bool:
-    """Masks ``a`` and ``b`` are adjacent; with depth, also at about the same distance (a real
-    contact, not one object seen in front of the other)."""
-    near = _dilate(a, TOUCH) & b
-    if depth is None or not near.any():
-        return bool(near.any())
-    grown_b = _dilate(b, TOUCH) & a
-    da, db = depth[grown_b], depth[near]
-    return bool(np.min(np.abs(da[:, None] - db[None, :])) < DEPTH_TOL) if da.size and db.size else False
-
-
-def _rows(mask: np.ndarray) -> tuple[int, int] | None:
-    rows = np.nonzero(mask.any(axis=1))[0]
-    return (int(rows[0]), int(rows[-1])) if len(rows) else None
+def _outline(obs: Observation, view: View, name: str) -> np.ndarray:
+    """``name``'s top-view outline now, including what is hidden now (e.g. under an object put on
+    it): its visible pixels and its outline before the subtask, moved to where it is now."""
+    now = _mask(obs, view, name)
+    before_view = obs.before.get(TOP)
+    if before_view is None:
+        return now
+    before = _mask(obs, before_view, name)
+    if not before.any() or not now.any():
+        return now | before
+    if (now & dilate(before, TOUCH)).sum() >= STILL * now.sum():  # it did not move
+        return now | before
+    return now | shift(before, *best_shift(before, now))
 
 
 # -- predicate checks: (observation, *objects) -> (ok, reason) -----------------------------------
@@ -115,19 +99,20 @@ def _rests_on(obs: Observation, a: str, b: str, inside: bool) -> tuple[bool, str
     front = obs.after.get(FRONT)
     if top is None or front is None:
         return False, "the top and front views are needed"
-    ma, mb = _mask(obs, top, a), _mask(obs, top, b)
-    before = obs.before.get(TOP)
-    if before is not None:  # ``a`` now hides part of ``b``: take ``b``'s outline from before too
-        mb = mb | _mask(obs, before, b)
+    ma, mb = _mask(obs, top, a), _outline(obs, top, b)  # ``a`` may hide part of ``b`` now
     if not ma.any():
         return False, f"{a} is not visible from the top"
+    if _covered(obs, top, b):  # from the top ``b`` is (mostly) hidden: where it is, the front view says
+        return _front_support(obs, front, a, b)
     if not mb.any():
         return False, f"{b} is not visible from the top"
     small, big = (ma, mb) if ma.sum() <= mb.sum() else (mb, ma)
-    overlap = float((small & _hull(big)).sum() / small.sum())
+    overlap = float((small & hull(big)).sum() / small.sum())
     if overlap < MIN_OVERLAP:
         return False, f"only {overlap:.0%} of {a} overlaps {b} from the top"
-    fa, fb = _rows(_mask(obs, front, a)), _rows(_mask(obs, front, b) | _mask(obs, front, a))
+    if not centroid_in(ma, mb, CENTRE_TOL):
+        return False, f"the centre of {a} is not over {b} from the top"
+    fa, fb = rows_of(_mask(obs, front, a)), rows_of(_mask(obs, front, b) | _mask(obs, front, a))
     if fa is not None and fb is not None:
         a_bottom = fa[1]
         if a_bottom < fb[0] - ROW_TOL and not inside:
@@ -135,6 +120,32 @@ def _rests_on(obs: Observation, a: str, b: str, inside: bool) -> tuple[bool, str
         if a_bottom > fb[1] + ROW_TOL:
             return False, f"{a} is below {b} in the front view"
     return True, f"{overlap:.0%} overlap from the top"
+
+
+def _covered(obs: Observation, top: View, b: str) -> bool:
+    """``b`` was visible from the top before the subtask and is now hidden (under another object):
+    entirely, or mostly and moved; either way its outline from before may not say where it is."""
+    before = obs.before.get(TOP)
+    if before is None:
+        return False
+    was, now = _mask(obs, before, b), _mask(obs, top, b)
+    if now.sum() >= COVERED * was.sum():
+        return False
+    return not now.any() or (now & dilate(was, TOUCH)).sum() < STILL * now.sum()
+
+
+def _front_support(obs: Observation, front: View, a: str, b: str) -> tuple[bool, str]:
+    """In the front view ``a`` lies above ``b``, over its columns, touching it at the same depth."""
+    fa, fb = _mask(obs, front, a), _mask(obs, front, b)
+    if not fa.any() or not fb.any():
+        return False, f"{b} is hidden from the top and {a} or {b} from the front"
+    ca, cb = np.nonzero(fa.any(axis=0))[0], np.nonzero(fb.any(axis=0))[0]
+    shared = min(ca[-1], cb[-1]) - max(ca[0], cb[0]) + 1
+    if shared < MIN_OVERLAP * min(len(ca), len(cb)):
+        return False, f"{a} is not over {b} in the front view"
+    if np.nonzero(fa)[0].mean() >= np.nonzero(fb)[0].mean() or not touch(fa, fb, front.depth):
+        return False, f"{a} does not rest on {b} in the front view"
+    return True, f"{b} is hidden from the top; {a} rests on it in the front view"
 
 
 def _on(obs: Observation, a: str, b: str) -> tuple[bool, str]:
@@ -147,9 +158,12 @@ def _inside(obs: Observation, a: str, b: str) -> tuple[bool, str]:
 
 def _released(obs: Observation, a: str) -> tuple[bool, str]:
     """A held object touches the hand in every view; a projection overlap in one is not contact."""
-    touching = [cam for cam, view in obs.after.items()
-                if _touch(view.segmentation == ROBOT, _mask(obs, view, a), view.depth)]
-    if touching and len(touching) == len(obs.after):
+    seen = {cam: view for cam, view in obs.after.items() if _mask(obs, view, a).any()}
+    if not seen:  # hidden in every view: inside the hand, or gone; no view shows it let go
+        return False, f"{a} is not visible in any view after the subtask"
+    touching = [cam for cam, view in seen.items()
+                if touch(view.segmentation == ROBOT, _mask(obs, view, a), view.depth)]
+    if touching and len(touching) == len(seen):
         return False, f"the robot still touches {a} in the {' and '.join(touching)} views"
     return True, "the robot is clear of it"
 
@@ -159,42 +173,43 @@ def _pressed(obs: Observation, x: str) -> tuple[bool, str]:
     if front is None or top is None:
         return False, "no view of the press"
     mx_front = _mask(obs, front, x)
-    if not _touch(front.segmentation == ROBOT, mx_front, front.depth):
+    if not touch(front.segmentation == ROBOT, mx_front, front.depth):
         return False, f"the hand never touched {x}"
     mx_top = _mask(obs, top, x)
     before = obs.before.get(TOP)
     if before is not None:  # the hand hides ``x`` from the top: use its outline from before
         mx_top = mx_top | _mask(obs, before, x)
-    hull = _hull(mx_top) if mx_top.any() else mx_top
-    if not np.any(_dilate(top.segmentation == ROBOT, TOUCH) & hull):
+    outline = hull(mx_top) if mx_top.any() else mx_top
+    if not np.any(dilate(top.segmentation == ROBOT, TOUCH) & outline):
         return False, f"the hand was not over {x}"
-    return _stayed(obs, x)
+    return True, "the hand touched and covered it at its lowest"
 
 
-def _stayed(obs: Observation, x: str) -> tuple[bool, str]:
-    before, after = obs.before.get(TOP), obs.after.get(TOP)
-    if before is None or after is None:
-        return False, "the top views before and after are needed"
-    mb, ma = _mask(obs, before, x), _mask(obs, after, x)
-    if not ma.any():
-        return False, f"{x} is not visible from the top afterwards"
-    iou = float((mb & ma).sum() / max(1, (mb | ma).sum()))
-    if iou < 0.5:
-        return False, f"{x} moved (top-view overlap with before {iou:.0%})"
-    return _upright(obs, x)
+def _hidden(view: View, mask: np.ndarray) -> int:
+    """Robot pixels on or around ``mask``'s hull: about as much of it as the robot can hide."""
+    if not mask.any():
+        return 0
+    return int(((view.segmentation == ROBOT) & dilate(hull(mask), TOUCH + 1)).sum())
 
 
 def _upright(obs: Observation, x: str) -> tuple[bool, str]:
+    """The orthographic top view sees an object's outline at its true size wherever it stands:
+    tipping changes its area or its shape; the robot can only hide part of it."""
     before, after = obs.before.get(TOP), obs.after.get(TOP)
     fb, fa = obs.before.get(FRONT), obs.after.get(FRONT)
     if before is None or after is None or fb is None or fa is None:
         return False, "the top and front views before and after are needed"
     mb, ma = _mask(obs, before, x), _mask(obs, after, x)
-    occluded = any(_touch(v.segmentation == ROBOT, m) for v, m in ((before, mb), (after, ma)))
-    area_b, area_a = mb.sum(), ma.sum()
-    if area_b and not occluded and not AREA_RATIO[0] <= area_a / area_b <= AREA_RATIO[1]:
-        return False, f"{x}'s top-view area changed by x{area_a / area_b:.2f} (tipped over?)"
-    rb, ra = _rows(_mask(obs, fb, x)), _rows(_mask(obs, fa, x))
+    hid_b, hid_a = _hidden(before, mb), _hidden(after, ma)
+    area_b, area_a = int(mb.sum()), int(ma.sum())
+    if area_b:  # the robot hides at most about the pixels it covers around the outline
+        if area_a > AREA_RATIO[1] * (area_b + hid_b) or area_a + hid_a < AREA_RATIO[0] * area_b:
+            return False, f"{x}'s top-view area changed by x{area_a / area_b:.2f} (tipped over?)"
+        if not hid_a and not hid_b and area_a:
+            axes = spread(ma)[-1] / max(1e-9, spread(mb)[-1])
+            if not 1 / SHAPE_RATIO <= axes <= SHAPE_RATIO:
+                return False, f"{x}'s top-view outline stretched by x{axes:.2f} (tipped over?)"
+    rb, ra = rows_of(_mask(obs, fb, x)), rows_of(_mask(obs, fa, x))
     if rb and ra and (ra[1] - ra[0] + 1) < HEIGHT_RATIO * (rb[1] - rb[0] + 1):
         return False, f"{x} looks lower in the front view than before (tipped over?)"
     return True, "upright"
@@ -214,7 +229,7 @@ def _on_table(obs: Observation, a: str) -> tuple[bool, str]:
         if other == a:
             continue
         mo = top.segmentation == i
-        if mo.sum() > ma.sum() and (ma & _hull(mo)).sum() > MIN_OVERLAP * ma.sum():
+        if mo.sum() > ma.sum() and (ma & hull(mo)).sum() > MIN_OVERLAP * ma.sum():
             return False, f"{a} lies over {other}, not on the table"
     return True, "on the table"
 
@@ -247,7 +262,7 @@ def _lifted(obs: Observation, a: str) -> tuple[bool, str]:
     fb, fa, top = obs.before.get(FRONT), obs.after.get(FRONT), obs.after.get(TOP)
     if fb is None or fa is None or top is None:
         return False, "the front views before and after and the top view are needed"
-    rb, ra = _rows(_mask(obs, fb, a)), _rows(_mask(obs, fa, a))
+    rb, ra = rows_of(_mask(obs, fb, a)), rows_of(_mask(obs, fa, a))
     if rb is None or ra is None:
         return False, f"{a} is not visible from the front"
     rise = rb[1] - ra[1]
@@ -256,7 +271,7 @@ def _lifted(obs: Observation, a: str) -> tuple[bool, str]:
     ma = _mask(obs, top, a)
     for i, other in enumerate(obs.labels):
         mo = top.segmentation == i
-        if other != a and mo.sum() > ma.sum() and (ma & _hull(mo)).sum() > MIN_OVERLAP * ma.sum():
+        if other != a and mo.sum() > ma.sum() and (ma & hull(mo)).sum() > MIN_OVERLAP * ma.sum():
             return False, f"{a} rests on {other}"
     return True, f"rose by {rise} px"
 

@@ -12,6 +12,7 @@ import math
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
+from typing import Protocol
 
 import numpy as np
 
@@ -38,6 +39,13 @@ SLOW_SPEED = 0.12  # m/s near objects
 JOINT_SPEED = 1.2  # rad/s cap on the fastest joint
 
 
+class SkillFault(Protocol):
+    """Plans a perturbed version of a skill call, or None to plan it as usual (see
+    :mod:`vcage.skills.faults`: silent failures injected to test critics)."""
+
+    def plan(self, skills: Skills, name: str, kwargs: dict[str, object]) -> MotionPlan | None: ...
+
+
 @dataclass(frozen=True)
 class GraspChoice:
     obj: str
@@ -49,8 +57,9 @@ class GraspChoice:
 class Skills:
     """Plans primitives on a world and executes them with one :class:`Player`."""
 
-    def __init__(self, world: World, player: Player | None = None) -> None:
+    def __init__(self, world: World, player: Player | None = None, fault: SkillFault | None = None) -> None:
         self.world = world
+        self.fault = fault  # None: every skill is planned as registered
         self.ik = IKSolver(ROBOT_MOUNT)
         self.player = player or Player(world)
         self.table_z = world.table_top()
@@ -83,7 +92,9 @@ class Skills:
 
     def do(self, name: str, **kwargs: object) -> MotionPlan:
         """Plan skill ``name`` from the current state and execute it."""
-        plan = SKILLS.get(name)(self, **kwargs)
+        plan = self.fault.plan(self, name, dict(kwargs)) if self.fault is not None else None
+        if plan is None:
+            plan = SKILLS.get(name)(self, **kwargs)
         self.player.run(plan)
         return plan
 

@@ -1,0 +1,230 @@
+"""Critics against the oracle on a balanced set of successes and injected silent failures.
+
+For every subtask of the chosen goals and every seed, the goal's plan runs up to that subtask in a
+V-CAGE scene (context-aware placement, checked scene, 4 distractors): once as planned, and once for
+each fault drawn for it from :mod:`vcage.skills.faults` (release high/early/late or never, off
+target, on an edge, wrong object, too light, hovering, beside the button, knocked over). The fault
+changes only what the robot does; the outcome is simulated in MuJoCo, and the label is the
+oracle's afterwards: an injected fault that still succeeded counts as a success, one that raised a
+skill error (no silent failure) is left out, and so is a sample whose earlier subtasks failed.
+
+Each critic judges the views it would get in a run (before, during and after the subtask). Printed
+per skill family and per fault: the sample's composition (successes, failures, distinct scenes),
+balanced accuracy, false-accept rate (failures accepted) and false-reject rate (successes
+rejected); "n/a" where a denominator is empty. The VLM critic is not measured here: the local fake
+server answers from a script, which would measure the script.
+
+    nice .venv/bin/python benchmarks/critic_failures.py --seeds 2 --workers 2 --cache /tmp/cf
+
+``--cache DIR`` stores every sample's observation (and re-uses it on the next run, so a changed
+critic is re-judged without simulating again).
+"""
+
+from __future__ import annotations
+
+import argparse
+import gzip
+import hashlib
+import json
+import os
+import pickle
+import time
+from collections.abc import Iterable
+from concurrent.futures import ProcessPoolExecutor
+from dataclasses import dataclass
+from pathlib import Path
+
+os.environ.setdefault("LP_NUM_THREADS", "1")  # one rasteriser thread: a worker is one core
+
+import numpy as np  # noqa: E402
+
+from vcage.critics import Critic, CriticConfig, Observation, Verdict, make_critic  # noqa: E402
+from vcage.pipeline.config import GenerateConfig  # noqa: E402
+from vcage.pipeline.episode import Timing  # noqa: E402
+from vcage.pipeline.plan_layout import plan_layout  # noqa: E402
+from vcage.pipeline.rollout import run_plan  # noqa: E402
+from vcage.pipeline.verifier import Verifier  # noqa: E402
+from vcage.planning import make_planner  # noqa: E402
+from vcage.planning.goals import GOALS  # noqa: E402
+from vcage.planning.schema import Plan  # noqa: E402
+from vcage.scene.instantiate import Instantiator  # noqa: E402
+from vcage.sim.render import Renderer  # noqa: E402
+from vcage.skills.base import Skills  # noqa: E402
+from vcage.skills.faults import FaultConfig, FaultInjector, faults_for  # noqa: E402
+from vcage.skills.playback import Player  # noqa: E402
+from vcage.skills.reachability import reach_map  # noqa: E402
+
+DEFAULT_GOALS = ("get_ready_for_work", "prepare_breakfast", "tidy_the_desk", "set_the_table",
+                 "build_a_tower", "sort_blocks_by_colour")
+CRITICS = ("image", "oracle")
+
+
+@dataclass
+class Sample:
+    goal: str
+    subtask: int
+    skill: str
+    fault: str | None  # None: run as planned
+    seed: int
+    scene: str  # hash of the instantiated scene (its spec)
+    success: bool  # the oracle's label of the subtask
+    obs: Observation
+
+
+class Keep(Critic):
+    """Keeps every observation and lets the rollout go on."""
+
+    def __init__(self) -> None:
+        self.seen: list[Observation] = []
+
+    def judge(self, obs: Observation) -> Verdict:
+        self.seen.append(obs)
+        return Verdict(True, "kept")
+
+
+def _plan(goal: str) -> Plan:
+    phrase = next(g for g in GOALS if g.name == goal).phrasings[0]
+    return make_planner("offline").plan(phrase)
+
+
+def rollout(goal: str, index: int, seed: int, fault: str | None) -> Sample | str:
+    """Run ``goal``'s plan up to subtask ``index`` (with ``fault`` injected into it); the sample of
+    that subtask, or why there is none."""
+    full = _plan(goal)
+    plan = full.model_copy(update={"subtasks": full.subtasks[:index + 1]})
+    cfg = GenerateConfig()
+    rng = np.random.default_rng(seed)
+    layout = plan_layout(full, rng, cfg.randomization, cfg.scene.clutter)  # one scene per goal and seed
+    inst = Instantiator(cfg.scene, cfg.sim, reach_map())
+    try:
+        spec, stats = inst.place(layout, rng)
+        instance = inst.realize(spec, stats)
+    except Exception as exc:  # noqa: BLE001 - a scene that cannot be made gives no sample
+        return f"scene: {type(exc).__name__}"
+    if not instance.valid:
+        return "scene: invalid"
+    world, sub = instance.world, plan.subtasks[index]
+    injector = None
+    if fault is not None:
+        occurrence = sum(s.skill == sub.skill for s in plan.subtasks[:index])
+        injector = FaultInjector(FaultConfig(fault, sub.skill, occurrence, seed))
+    skills = Skills(world, Player(world, record_states=True), fault=injector)
+    keep = Keep()
+    with Renderer(world, *cfg.render.critic_size, cfg.render.mesh_detail) as renderer:
+        verifier = Verifier(world, plan, keep, renderer, skills.player.recording, Timing())
+        result = run_plan(world, plan, skills, verifier)
+    outcomes = result.outcomes
+    if len(outcomes) <= index or outcomes[index].skill_error is not None:
+        return "skill error"
+    if not all(o.oracle_success for o in outcomes[:index]):
+        return "an earlier subtask failed"
+    if injector is not None and not injector.applied:
+        return "fault not applicable"
+    scene = hashlib.sha1(json.dumps(spec.to_dict(), sort_keys=True, default=str).encode()).hexdigest()[:12]
+    return Sample(goal, index, sub.skill, fault, seed, scene, outcomes[index].oracle_success,
+                  keep.seen[index])
+
+
+def _job(job: tuple[str, int, int, str | None, str | None]) -> Sample | str:
+    goal, index, seed, fault, cache = job
+    path = Path(cache) / f"{goal}-{index}-{seed}-{fault or 'none'}.pkl.gz" if cache else None
+    if path is not None and path.is_file():
+        with gzip.open(path, "rb") as f:
+            return pickle.load(f)  # noqa: S301 - our own cache
+    out = rollout(goal, index, seed, fault)
+    if path is not None:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        with gzip.open(path, "wb", compresslevel=3) as f:
+            pickle.dump(out, f)
+    return out
+
+
+def jobs(goals: Iterable[str], seeds: int, faults_per_seed: int, cache: str | None
+         ) -> list[tuple[str, int, int, str | None, str | None]]:
+    out: list[tuple[str, int, int, str | None, str | None]] = []
+    for goal in goals:
+        for i, sub in enumerate(_plan(goal).subtasks):
+            names = faults_for(sub.skill)
+            for seed in range(seeds):
+                out.append((goal, i, seed, None, cache))
+                for k in range(faults_per_seed if names else 0):  # rotate through the faults, seed by seed
+                    out.append((goal, i, seed, names[(seed * faults_per_seed + k + i) % len(names)], cache))
+    return out
+
+
+# -- figures ------------------------------------------------------------------------------------------
+
+def _pct(num: int, den: int) -> str:
+    return f"{num / den:6.1%}" if den else "   n/a"
+
+
+def row(name: str, samples: list[Sample], accepts: list[bool]) -> str:
+    succ = [a for s, a in zip(samples, accepts, strict=True) if s.success]
+    fail = [a for s, a in zip(samples, accepts, strict=True) if not s.success]
+    tpr, tnr = (sum(succ), len(succ)), (sum(not a for a in fail), len(fail))
+    bal = (f"{(tpr[0] / tpr[1] + tnr[0] / tnr[1]) / 2:6.1%}" if tpr[1] and tnr[1] else "   n/a")
+    scenes = len({(s.goal, s.scene) for s in samples})
+    false_accept, false_reject = _pct(sum(fail), len(fail)), _pct(len(succ) - sum(succ), len(succ))
+    return (f"{name:28s} {len(succ):5d} {len(fail):5d} {scenes:6d}  {bal:>7s} {false_accept:>7s} "
+            f"{false_reject:>7s}")
+
+
+HEAD = f"{'':28s} {'succ':>5s} {'fail':>5s} {'scenes':>6s}  {'bal.acc':>7s} {'FA':>7s} {'FR':>7s}"
+
+
+def report(samples: list[Sample], critic: str, accepts: list[bool]) -> None:
+    print(f"\n{critic} critic vs oracle")
+    print(HEAD)
+    print(row("all", samples, accepts))
+    for key, label in ((lambda s: s.skill, "skill"), (lambda s: s.fault or "(as planned)", "fault"),
+                       (lambda s: f"{s.goal}#{s.subtask + 1}", "subtask")):
+        for value in sorted({key(s) for s in samples}):
+            pick = [k for k, s in enumerate(samples) if key(s) == value]
+            print(row(f"{label} {value}"[:28], [samples[k] for k in pick], [accepts[k] for k in pick]))
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__,
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--seeds", type=int, default=2, help="scenes per subtask (seeds 0..N-1)")
+    parser.add_argument("--faults-per-seed", type=int, default=2)
+    parser.add_argument("--goals", nargs="*", default=list(DEFAULT_GOALS))
+    parser.add_argument("--workers", type=int, default=2)
+    parser.add_argument("--cache", default=None, help="directory for the samples' observations")
+    parser.add_argument("--show-errors", action="store_true", help="print each misjudged sample")
+    args = parser.parse_args()
+    todo = jobs(args.goals, args.seeds, args.faults_per_seed, args.cache)
+    t0 = time.perf_counter()
+    with ProcessPoolExecutor(args.workers) as pool:
+        results = list(pool.map(_job, todo))
+    samples = [r for r in results if isinstance(r, Sample)]
+    skipped: dict[str, int] = {}
+    for r in results:
+        if isinstance(r, str):
+            skipped[r] = skipped.get(r, 0) + 1
+    injected = [s for s in samples if s.fault is not None]
+    bare = sorted({sub.skill for g in args.goals for sub in _plan(g).subtasks if not faults_for(sub.skill)})
+    if bare:
+        print(f"no faults registered for skill(s) {', '.join(bare)}: their subtasks give successes only")
+    print(f"balanced set: goals {', '.join(args.goals)}; {args.seeds} seeds per subtask, as planned + "
+          f"{args.faults_per_seed} injected faults per seed; {len(todo)} rollouts, {len(samples)} samples "
+          f"({sum(s.success for s in samples)} successes, {sum(not s.success for s in samples)} failures; "
+          f"{sum(s.success for s in injected)} injected faults still succeeded), "
+          f"{len({(s.goal, s.scene) for s in samples})} distinct scenes; left out: {skipped or 'none'}; "
+          f"{time.perf_counter() - t0:.0f} s wall")
+    print("succ/fail: the oracle's labels; scenes: distinct instantiated scenes; bal.acc: mean of the "
+          "accept rate on successes and the reject rate on failures; FA: failures accepted; FR: "
+          "successes rejected; n/a: empty denominator")
+    for name in CRITICS:
+        critic = make_critic(CriticConfig(name))
+        verdicts = [critic.judge(s.obs) for s in samples]
+        report(samples, name, [v.accept for v in verdicts])
+        if args.show_errors:
+            for s, v in zip(samples, verdicts, strict=True):
+                if v.accept != s.success:
+                    print(f"  {'FA' if v.accept else 'FR'} {s.goal}#{s.subtask + 1} seed {s.seed} "
+                          f"{s.fault or '-'}: {v.reason}; oracle {s.obs.oracle}")
+
+
+if __name__ == "__main__":
+    main()

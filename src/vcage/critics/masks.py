@@ -1,0 +1,88 @@
+"""Pixel-mask geometry for the image critic: hulls, dilation, contact, translation, extents.
+
+Pure numpy (and shapely for hulls) on boolean masks of one view; nothing here knows about objects,
+predicates or the simulator.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import shapely
+from shapely.geometry import MultiPoint
+
+TOUCH = 2  # pixels: masks closer than this touch
+DEPTH_TOL = 0.02  # metres: adjacent pixels this close in depth are in contact
+
+
+def hull(mask: np.ndarray) -> np.ndarray:
+    """The filled convex hull of a mask's pixels."""
+    rows, cols = np.nonzero(mask)
+    if len(rows) < 3:
+        return mask.copy()
+    shape = MultiPoint(np.column_stack([cols, rows]).astype(float)).convex_hull.buffer(0.5)
+    r0, r1, c0, c1 = rows.min(), rows.max() + 1, cols.min(), cols.max() + 1
+    cc, rr = np.meshgrid(np.arange(c0, c1), np.arange(r0, r1))
+    out = np.zeros_like(mask)
+    out[r0:r1, c0:c1] = shapely.contains_xy(shape, cc.astype(float), rr.astype(float))
+    return out | mask
+
+
+def dilate(mask: np.ndarray, px: int) -> np.ndarray:
+    out = mask.copy()
+    for _ in range(px):
+        grown = out.copy()
+        grown[1:] |= out[:-1]
+        grown[:-1] |= out[1:]
+        grown[:, 1:] |= out[:, :-1]
+        grown[:, :-1] |= out[:, 1:]
+        out = grown
+    return out
+
+
+def touch(a: np.ndarray, b: np.ndarray, depth: np.ndarray | None = None) -> bool:
+    """Masks ``a`` and ``b`` are adjacent; with depth, also at about the same distance (a real
+    contact, not one object seen in front of the other)."""
+    near = dilate(a, TOUCH) & b
+    if depth is None or not near.any():
+        return bool(near.any())
+    grown_b = dilate(b, TOUCH) & a
+    da, db = depth[grown_b], depth[near]
+    return bool(np.min(np.abs(da[:, None] - db[None, :])) < DEPTH_TOL) if da.size and db.size else False
+
+
+def shift(mask: np.ndarray, dr: int, dc: int) -> np.ndarray:
+    out = np.zeros_like(mask)
+    h, w = mask.shape
+    src = mask[max(0, -dr):h - max(0, dr), max(0, -dc):w - max(0, dc)]
+    out[max(0, dr):max(0, dr) + src.shape[0], max(0, dc):max(0, dc) + src.shape[1]] = src
+    return out
+
+
+def best_shift(before: np.ndarray, now: np.ndarray) -> tuple[int, int]:
+    """The translation (rows, columns) that lays ``before`` best over ``now`` (cross-correlation)."""
+    h, w = before.shape
+    fa = np.fft.rfft2(now.astype(float), s=(2 * h, 2 * w))
+    fb = np.fft.rfft2(before.astype(float), s=(2 * h, 2 * w))
+    corr = np.fft.irfft2(fa * np.conj(fb), s=(2 * h, 2 * w))
+    r, c = np.unravel_index(int(np.argmax(corr)), corr.shape)
+    return (int(r) if r < h else int(r) - 2 * h), (int(c) if c < w else int(c) - 2 * w)
+
+
+def rows_of(mask: np.ndarray) -> tuple[int, int] | None:
+    rows = np.nonzero(mask.any(axis=1))[0]
+    return (int(rows[0]), int(rows[-1])) if len(rows) else None
+
+
+def spread(mask: np.ndarray) -> np.ndarray:
+    """Standard deviations of a mask's pixels along its principal axes (rotation invariant)."""
+    rows, cols = np.nonzero(mask)
+    if len(rows) < 3:
+        return np.zeros(2)
+    return np.sqrt(np.maximum(np.linalg.eigvalsh(np.cov(np.stack([rows, cols]).astype(float))), 0.0))
+
+
+def centroid_in(mask: np.ndarray, region: np.ndarray, tol: int) -> bool:
+    """The centre of ``mask``'s pixels lies in ``region``'s hull grown by ``tol`` pixels."""
+    rows, cols = np.nonzero(mask)
+    r, c = int(round(float(rows.mean()))), int(round(float(cols.mean())))
+    return bool(dilate(hull(region), tol)[r, c])

@@ -1,0 +1,60 @@
+"""Real failed rollouts for critic tests: a small scene, one subtask, a fault injected into its skill.
+
+The subtask runs in MuJoCo through the pipeline's own rollout and verifier (views rendered before,
+during and after it); nothing is teleported. Returns what the critic saw and the oracle's values.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from vcage.critics.base import Critic, Observation, Verdict
+from vcage.pipeline.episode import Timing
+from vcage.pipeline.rollout import SubtaskOutcome, run_plan
+from vcage.pipeline.verifier import Verifier
+from vcage.planning.schema import Plan, PlanObject, Subtask
+from vcage.scene.compose import compose
+from vcage.scene.spec import ObjectSpec, SceneSpec
+from vcage.sim.render import Renderer
+from vcage.skills.base import Skills
+from vcage.skills.faults import FaultConfig, FaultInjector
+from vcage.skills.playback import Player
+
+
+class Keep(Critic):
+    """Keeps what it was shown; accepts, so the rollout goes on."""
+
+    def __init__(self) -> None:
+        self.seen: list[Observation] = []
+
+    def judge(self, obs: Observation) -> Verdict:
+        self.seen.append(obs)
+        return Verdict(True, "kept")
+
+
+@dataclass
+class Run:
+    obs: Observation
+    outcome: SubtaskOutcome
+    applied: bool  # whether the fault was injected
+
+    @property
+    def success(self) -> bool:
+        return self.outcome.oracle_success
+
+
+def run(objects: tuple[ObjectSpec, ...], subtask: Subtask, fault: str | None = None, seed: int = 0) -> Run:
+    """Execute ``subtask`` in a scene of ``objects`` with ``fault`` injected into its skill."""
+    world = compose(SceneSpec(objects=objects)).make_world()
+    world.settle(0.3)
+    plan = Plan(instruction="test", objects=tuple(PlanObject(name=o.name, type=o.type) for o in objects),
+                subtasks=(subtask,))
+    injector = FaultInjector(FaultConfig(fault, subtask.skill, 0, seed)) if fault else None
+    skills = Skills(world, Player(world, record_states=True), fault=injector)
+    keep = Keep()
+    with Renderer(world, 320, 240) as renderer:
+        verifier = Verifier(world, plan, keep, renderer, skills.player.recording, Timing())
+        rollout = run_plan(world, plan, skills, verifier)
+    outcome = rollout.outcomes[0]
+    assert outcome.skill_error is None, outcome.skill_error
+    return Run(keep.seen[0], outcome, injector is None or injector.applied)

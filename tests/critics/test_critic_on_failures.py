@@ -1,0 +1,105 @@
+"""The image critic on real failed rollouts: faults injected into the skills, executed in MuJoCo.
+
+Every image check has a case here where the oracle says its predicate failed after a rollout with
+an injected fault (nothing teleported), and the check itself must say so: replacing any check of
+``IMAGE_CHECKS`` with "accept" fails a test. The same scenes run as planned must be accepted, so a
+critic that rejects everything fails too.
+"""
+
+from __future__ import annotations
+
+import pytest
+
+from critics.faulted import Run, run
+from vcage.critics.image import ImageCritic
+from vcage.planning.goals import press, put_in, put_on
+from vcage.planning.schema import Predicate, Subtask
+from vcage.scene.spec import ObjectSpec as O
+
+CRITIC = ImageCritic()
+
+
+def _sub(skill: str, args: dict[str, object], *preds: tuple[str, tuple[str, ...]]) -> Subtask:
+    return Subtask(skill=skill, args=args, description="a subtask under test",
+                   predicates=tuple(Predicate(name=n, args=a) for n, a in preds))
+
+
+BLOCK_PAD = (O("block", "block", (0.5, -0.12)), O("pad", "mouse_pad", (0.58, 0.1)))
+BREAD_BASKET = (O("bread", "bread", (0.5, -0.12)), O("basket", "basket", (0.58, 0.12)))
+BELL = (O("bell", "bell", (0.55, 0.05)),)
+CLOCK = (O("clock", "alarm_clock", (0.55, 0.05)),)
+MOUSE_PAD = (O("mouse", "mouse", (0.5, -0.12)), O("pad", "mouse_pad", (0.55, 0.12)))
+TWO_BLOCKS = (O("a", "block", (0.5, -0.15)), O("b", "block", (0.55, 0.1)))
+STACK = (O("a", "block", (0.5, -0.12)), O("b", "block", (0.55, 0.1)))
+ROW_LEFT = (O("a", "block", (0.5, -0.1)), O("b", "block", (0.55, 0.05)))
+ROW_RIGHT = (O("a", "block", (0.5, 0.1)), O("b", "block", (0.55, -0.05)))
+
+SCENARIOS: dict[str, tuple[tuple[O, ...], Subtask]] = {
+    "on": (BLOCK_PAD, put_on("block", "pad", "the block is on the pad")),
+    "inside": (BREAD_BASKET, put_in("bread", "basket", "the bread is in the basket")),
+    "pressed": (BELL, press("bell", "the bell is rung")),
+    "upright": (CLOCK, press("clock", "the clock's button is pressed")),
+    "on_table": (MOUSE_PAD, _sub("pick_and_place", {"obj": "mouse", "xy": [0.55, 0.02]},
+                                 ("on_table", ("mouse",)), ("released", ("mouse",)))),
+    "near": (TWO_BLOCKS, _sub("pick_and_place", {"obj": "a", "xy": [0.55, 0.04]},
+                              ("near", ("a", "b")), ("released", ("a",)))),
+    "lifted": ((O("block", "block", (0.55, 0.0)),), _sub("grasp", {"obj": "block"}, ("lifted", ("block",)))),
+    "stacked": (STACK, _sub("pick_and_place", {"obj": "a", "target": "b"},
+                            ("stacked", ("b", "a")), ("released", ("a",)))),
+    "left_of": (ROW_LEFT, _sub("pick_and_place", {"obj": "a", "xy": [0.5, 0.18]},
+                               ("left_of", ("a", "b")), ("released", ("a",)))),
+    "right_of": (ROW_RIGHT, _sub("pick_and_place", {"obj": "a", "xy": [0.5, -0.18]},
+                                 ("right_of", ("a", "b")), ("released", ("a",)))),
+}
+
+# (scenario, fault, seed, the predicate that must fail in the oracle and in the critic's checks)
+FAILURES = [
+    ("on", "off_target", 1, "on(block, pad)"),
+    ("on", "release_late", 2, "on(block, pad)"),
+    ("inside", "off_target", 1, "inside(bread, basket)"),
+    ("inside", "on_edge", 0, "inside(bread, basket)"),
+    ("on", "no_release", 0, "released(block)"),
+    ("pressed", "press_hover", 0, "pressed(bell)"),
+    ("pressed", "press_miss", 0, "pressed(bell)"),
+    ("upright", "knock_over", 1, "upright(clock)"),
+    ("on_table", "off_target", 2, "on_table(mouse)"),
+    ("near", "off_target", 0, "near(a, b)"),
+    ("near", "release_early", 0, "near(a, b)"),
+    ("lifted", "grasp_miss", 0, "lifted(block)"),
+    ("stacked", "off_target", 0, "stacked(b, a)"),
+    ("left_of", "wrong_object", 0, "left_of(a, b)"),
+    ("right_of", "wrong_object", 0, "right_of(a, b)"),
+]
+
+
+def _run(scenario: str, fault: str | None = None, seed: int = 0) -> Run:
+    objects, subtask = SCENARIOS[scenario]
+    return run(objects, subtask, fault, seed)
+
+
+@pytest.mark.parametrize("scenario", sorted(SCENARIOS))
+def test_the_scene_done_as_planned_is_accepted(scenario: str) -> None:
+    result = _run(scenario)
+    verdict = CRITIC.judge(result.obs)
+    assert result.success, result.outcome.oracle
+    assert verdict.accept, verdict.reason
+
+
+@pytest.mark.parametrize(("scenario", "fault", "seed", "predicate"), FAILURES,
+                         ids=[f"{f}-{p}" for _, f, _, p in FAILURES])
+def test_an_injected_silent_failure_is_rejected_by_its_check(scenario: str, fault: str, seed: int,
+                                                             predicate: str) -> None:
+    result = _run(scenario, fault, seed)
+    assert result.applied and result.outcome.skill_error is None
+    assert result.outcome.oracle[predicate] is False, result.outcome.oracle  # a real failure
+    verdict = CRITIC.judge(result.obs)
+    assert not verdict.accept
+    assert verdict.details["checks"][predicate] is False, verdict.reason
+    assert predicate in verdict.reason
+
+
+def test_the_checks_under_test_cover_every_image_check() -> None:
+    from vcage.critics.image import IMAGE_CHECKS
+
+    tested = {p.split("(")[0] for *_, p in FAILURES}
+    assert tested == set(IMAGE_CHECKS.names())

@@ -1,0 +1,104 @@
+"""The oracle's negative cases: what must *not* count as a press, inside, released, left/right, near.
+
+The oracle labels every critic figure, so a predicate that holds too easily would make every
+critic look better than it is. Each case below is a real MuJoCo state (settled, or reached by the
+skills), never a flag set by hand.
+"""
+
+from __future__ import annotations
+
+from vcage.planning.schema import Predicate
+from vcage.scene.compose import compose
+from vcage.scene.spec import ObjectSpec, SceneSpec
+from vcage.sim.world import World
+from vcage.skills.base import Skills
+from vcage.skills.faults import FaultConfig, FaultInjector
+from vcage.tasks.oracle import Oracle
+from vcage.tasks.predicates import ORACLE_CHECKS
+
+PRESSED = Predicate(name="pressed", args=("bell",))
+
+
+def _settled(*objects: ObjectSpec) -> World:
+    world = compose(SceneSpec(objects=objects)).make_world()
+    world.settle(0.5)
+    return world
+
+
+def _value(world: World, name: str, *args: str) -> bool:
+    return ORACLE_CHECKS.get(name)(world, *args)
+
+
+def _watched(skills: Skills) -> Oracle:
+    oracle = Oracle()
+    skills.player.hooks.append(oracle.on_step)
+    oracle.begin([PRESSED])
+    return oracle
+
+
+def test_a_press_latches_and_stays_latched_after_the_button_springs_back() -> None:
+    world = _settled(ObjectSpec("bell", "bell", (0.55, 0.05)))
+    skills = Skills(world)
+    oracle = _watched(skills)
+    skills.do("press", obj="bell")
+    skills.do("retreat")
+    assert not _value(world, "pressed", "bell")  # the button is back up ...
+    assert oracle.check(world, [PRESSED]) == {"pressed(bell)": True}  # ... but it was pressed
+
+
+def test_a_light_press_a_hover_and_a_press_before_watching_do_not_count() -> None:
+    for fault in ("press_light", "press_hover"):
+        world = _settled(ObjectSpec("bell", "bell", (0.55, 0.05)))
+        skills = Skills(world, fault=FaultInjector(FaultConfig(fault, "press")))
+        oracle = _watched(skills)
+        skills.do("press", obj="bell")
+        assert oracle.check(world, [PRESSED]) == {"pressed(bell)": False}, fault
+    world = _settled(ObjectSpec("bell", "bell", (0.55, 0.05)))
+    skills = Skills(world)
+    oracle = Oracle()
+    skills.player.hooks.append(oracle.on_step)
+    skills.do("press", obj="bell")  # pressed before the subtask began
+    oracle.begin([PRESSED])
+    skills.do("retreat")
+    assert oracle.check(world, [PRESSED]) == {"pressed(bell)": False}
+    assert Oracle().check(world, [PRESSED]) == {"pressed(bell)": False}  # never watched
+
+
+def test_inside_needs_the_region_and_the_height_below_the_rim() -> None:
+    beside = _settled(ObjectSpec("bread", "bread", (0.5, -0.08)), ObjectSpec("basket", "basket", (0.5, 0.1)))
+    assert not _value(beside, "inside", "bread", "basket")
+    inside = _settled(ObjectSpec("bread", "bread", (0.5, 0.1), z=0.78),
+                      ObjectSpec("basket", "basket", (0.5, 0.1)))
+    assert _value(inside, "inside", "bread", "basket")
+    above = compose(SceneSpec(objects=(ObjectSpec("bread", "bread", (0.5, 0.1), z=0.95),
+                                       ObjectSpec("basket", "basket", (0.5, 0.1))))).make_world()
+    above.forward()  # held over the basket, in its region but above the rim
+    assert not _value(above, "inside", "bread", "basket")
+
+
+def test_released_is_false_while_the_hand_holds_the_object() -> None:
+    world = _settled(ObjectSpec("block", "block", (0.55, 0.0)))
+    skills = Skills(world)
+    skills.do("grasp", obj="block")
+    skills.do("lift")
+    assert not _value(world, "released", "block") and _value(world, "lifted", "block")
+    skills.do("open_gripper")
+    skills.player.wait(0.5)
+    assert _value(world, "released", "block")
+
+
+def test_left_and_right_need_the_margin_and_are_exclusive() -> None:
+    world = _settled(ObjectSpec("a", "block", (0.5, 0.12)), ObjectSpec("b", "block", (0.5, -0.12)),
+                     ObjectSpec("c", "block", (0.62, 0.14)))
+    assert _value(world, "left_of", "a", "b") and not _value(world, "right_of", "a", "b")
+    assert _value(world, "right_of", "b", "a") and not _value(world, "left_of", "b", "a")
+    # c is 2 cm left of a: within the 3 cm margin neither holds
+    assert not _value(world, "left_of", "c", "a") and not _value(world, "right_of", "c", "a")
+    assert not _value(world, "left_of", "a", "c") and not _value(world, "right_of", "a", "c")
+
+
+def test_near_is_false_beyond_ten_centimetres() -> None:
+    world = _settled(ObjectSpec("a", "block", (0.5, 0.0)), ObjectSpec("b", "block", (0.5, 0.09)),
+                     ObjectSpec("c", "block", (0.5, -0.115)))
+    assert _value(world, "near", "a", "b") and _value(world, "near", "b", "a")
+    assert not _value(world, "near", "a", "c") and not _value(world, "near", "b", "c")
