@@ -1,8 +1,9 @@
 """What import contracts cannot check: dynamic code execution stays out of the package.
 
-``exec``/``eval``/``compile`` of text belong to one sandbox module (generated subtask code, not
-written yet); until it exists, no module may call them. Import contracts (``lint-imports``,
-configured in pyproject.toml) check the layers.
+``exec``/``eval``/``compile`` of text belong to one sandbox module: the child process that runs
+generated subtask code (``sandbox/child.py``, started as its own interpreter, never imported); no
+other module may call them. Import contracts (``lint-imports``, configured in pyproject.toml) check
+the layers.
 """
 
 from __future__ import annotations
@@ -12,7 +13,7 @@ from pathlib import Path
 
 import vcage
 
-SANDBOX: set[str] = set()  # modules allowed to execute text as code (relative to src/vcage)
+SANDBOX = {"sandbox/child.py"}  # modules allowed to execute text as code (relative to src/vcage)
 DANGEROUS = {"exec", "eval", "compile", "__import__"}
 
 
@@ -27,6 +28,24 @@ def test_no_module_outside_the_sandbox_executes_text_as_code() -> None:
     found = {str(p.relative_to(root)): calls for p in sorted(root.rglob("*.py"))
              if (calls := _calls(p)) and str(p.relative_to(root)) not in SANDBOX}
     assert found == {}
+
+
+def test_the_sandbox_module_is_the_one_that_executes_and_nothing_imports_it() -> None:
+    root = Path(vcage.__file__).parent
+    assert {name for name in SANDBOX if _calls(root / name)} == SANDBOX  # the exception is used
+    importers = [str(p.relative_to(root)) for p in sorted(root.rglob("*.py")) if _imports_child(p)]
+    assert importers == []  # the runner starts it as a script by path
+
+
+def _imports_child(path: Path) -> bool:
+    for node in ast.walk(ast.parse(path.read_text(), str(path))):
+        if isinstance(node, ast.Import) and any(a.name.endswith("sandbox.child") for a in node.names):
+            return True
+        if isinstance(node, ast.ImportFrom) and (
+                (node.module or "").endswith("sandbox.child")
+                or ((node.module or "").endswith("sandbox") and any(a.name == "child" for a in node.names))):
+            return True
+    return False
 
 
 def test_the_scan_sees_a_call(tmp_path: Path) -> None:

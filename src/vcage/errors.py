@@ -115,3 +115,34 @@ class CorruptDatasetError(DatasetError):
 
 class PlanningError(VcageError):
     """An instruction cannot be grounded into a valid plan; the message says what the planner can do."""
+
+
+class SandboxError(VcageError):
+    """Generated code could not be run in the sandbox (the child process would not start, or answered
+    outside its protocol); the message says what to check."""
+
+
+class CodeRejectedError(SandboxError, ValueError):
+    """Generated code failed the sandbox's static checks and was never run; the message names each
+    violation with its line, so a model (or a person) can rewrite the program."""
+
+
+class SubtaskError(VcageError, ValueError):
+    """A candidate subtask is invalid: an unknown skill or object, a missing or extra argument, a
+    number that is not finite or a position off the table; the message names the argument."""
+
+
+class SubtaskStoreError(VcageError):
+    """The subtask database cannot be used as asked; the message names the file and what to change."""
+
+
+class SubtaskStoreLockedError(SubtaskStoreError):
+    """Another process holds the subtask database's write lock for longer than the busy timeout."""
+
+
+class SubtaskStoreReadOnlyError(SubtaskStoreError):
+    """The subtask database file (or its directory, which holds the WAL files) is not writable."""
+
+
+class CorruptSubtaskStoreError(SubtaskStoreError):
+    """The subtask database file is not a readable SQLite database of vcage's schema."""

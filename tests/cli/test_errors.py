@@ -17,12 +17,16 @@ from vcage.errors import ConfigError
 RUN = CliRunner()
 VERBS = ["tasks", "plan", "generate", "inspect", "audit", "report", "verify", "backfill", "export", "catalog",
          "scene", "run", "demo", "synthesize", "train", "evaluate"]
+GROUPS = ["subtasks"]  # verbs with sub-commands; `vcage --help` lists them after the VERBS
 
 
 def test_every_command_is_registered_in_order_and_wrapped() -> None:
     names = [c.name for c in app.registered_commands]
     assert names == VERBS
-    unwrapped = [c.name for c in app.registered_commands if not getattr(c.callback, MARKER, False)]
+    assert [g.name for g in app.registered_groups] == GROUPS
+    commands = list(app.registered_commands) + [c for g in app.registered_groups
+                                                for c in g.typer_instance.registered_commands]
+    unwrapped = [c.name for c in commands if not getattr(c.callback, MARKER, False)]
     assert unwrapped == []
 
 
@@ -60,5 +64,8 @@ def test_python_dash_m_runs_the_cli(args: list[str]) -> None:
                           timeout=60, env={**os.environ, "COLUMNS": "100"})
     out = done.stdout + done.stderr
     assert "Usage: python -m vcage.cli" in out
-    assert all(verb in out for verb in VERBS)
+    assert all(verb in out for verb in VERBS + GROUPS)
+    listed = [line.split()[1] for line in out.splitlines() if line.startswith("│ ") and len(line.split()) > 2
+              and line.split()[1] in VERBS + GROUPS]
+    assert listed == VERBS + GROUPS
     assert done.returncode == (0 if args else 2)

@@ -13,6 +13,7 @@ from vcage.cli._app import app, console
 from vcage.cli import tasks, plan, generate, inspect_cmd, audit, report, verify  # noqa: F401
 from vcage.cli import backfill, export, catalog, scene, run  # noqa: F401
 from vcage.cli import synthesize  # noqa: F401
+from vcage.cli import subtasks  # noqa: F401
 from vcage.cli import train, evaluate  # noqa: F401
 # isort: on
 
