@@ -23,7 +23,9 @@ MAX_GRASP_WIDTH = 0.065
 PALM_ABOVE_TCP = 0.045  # the Panda's palm is ~47 mm above the grasp point (between the pads)
 PRESS_FORCE = 10.0  # N, pushed along the functional point's direction
 ALL = CATALOG.names()
-CONTAINERS = [o.name for o in CATALOG.values() if any(p.kind == "in" for p in o.placements)]
+# a drawer's inside is filled through its opening, not from above (its task puts an object in)
+CONTAINERS = [o.name for o in CATALOG.values()
+              if any(p.kind == "in" for p in o.placements) and "articulated" not in o.tags]
 PRESSABLE = [o.name for o in CATALOG.values() if any(f.joint for f in o.functional_points)]
 
 
@@ -89,6 +91,22 @@ REQUIRED = {
     "phone_stand": (set(), {"slot": "on"}, {}),
     "playing_card": (set(), {}, {}),
     "object_stand": (set(), {"top": "on"}, {}),
+    # the RoboTwin-style tasks' objects
+    "hammer": ({"handle"}, {}, {"head": ("striker", None)}),
+    "roller": ({"barrel"}, {}, {}),
+    "qr_board": ({"board"}, {}, {"code": ("display", None)}),
+    "fan": ({"head"}, {}, {"outlet": ("outlet", None)}),
+    "shoe": ({"upper"}, {}, {}),
+    "shoe_box": (set(), {"inside": "in"}, {}),
+    "pill_bottle": ({"body"}, {}, {}),
+    "burger": ({"top"}, {}, {}),
+    "fries": ({"carton"}, {}, {}),
+    "plastic_box": (set(), {"inside": "in"}, {}),
+    "dustbin": (set(), {"inside": "in"}, {}),
+    "kitchen_scale": (set(), {"top": "on"}, {}),
+    "card_deck": (set(), {}, {}),
+    "cabinet": (set(), {"inside": "in"}, {"handle": ("handle", "drawer")}),
+    "mug_rack": (set(), {}, {"peg": ("hook", None)}),
 }
 
 
@@ -101,7 +119,8 @@ def test_required_types_and_annotations(name: str) -> None:
         assert otype.placement(pname).kind == kind
     for fname, (kind, joint) in points.items():
         fp = otype.functional_point(fname)
-        assert (fp.kind, fp.joint) == (kind, joint) and fp.travel > 0
+        assert (fp.kind, fp.joint) == (kind, joint)
+        assert fp.travel > 0 if joint else abs(float(np.linalg.norm(fp.direction)) - 1.0) < 1e-9
 
 
 def test_required_details() -> None:
@@ -244,7 +263,7 @@ def test_pressing_the_functional_point_moves_its_joint(name: str) -> None:
     assert moved >= fp.travel, (moved, fp.travel)
     world.settle(0.7)
     after = world.joint_value(joint)
-    if fp.kind == "switch":  # bistable: stays on the pressed side
+    if fp.kind in ("switch", "handle"):  # bistable, or a drawer with no spring: stays where moved
         assert abs(after - q0) >= fp.travel, after
     else:  # spring-loaded: comes back
         assert abs(after - q0) < 0.25 * fp.travel, (after, q0)

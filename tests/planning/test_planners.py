@@ -17,12 +17,37 @@ from vcage.planning.schema import Plan
 OFFLINE = OfflinePlanner()
 
 
-def test_goal_library_has_ten_goals_of_three_to_six_subtasks() -> None:
-    assert len(GOALS) >= 10
+def test_goal_library_has_twenty_goals_of_three_to_six_subtasks() -> None:
+    assert len(GOALS) >= 20
+    lengths = []
     for goal in GOALS:
         plan = goal.plan(goal.phrasings[0])
         assert 3 <= len(plan.subtasks) <= 6, goal.name
         assert all(st.predicates for st in plan.subtasks)
+        lengths.append(len(plan.subtasks))
+    assert sum(n >= 4 for n in lengths) >= 4 and max(lengths) == 6
+
+
+def test_goal_subtasks_use_only_what_the_image_critic_judges() -> None:
+    from vcage.critics.image import IMAGE_CHECKS
+
+    used = {p.name for goal in GOALS for st in goal.subtasks for p in st.predicates}
+    assert used <= set(IMAGE_CHECKS.names())
+
+
+@pytest.mark.parametrize("goal, first, then", [
+    ("nest_and_stow", "small", "large"),  # the nested bowls are moved together
+    ("raise_a_skyscraper", "second", "third"),  # each block goes on the one placed before
+    ("weigh_the_fruit", "apple", "orange"),  # the scale is free again only after the apple left it
+])
+def test_goals_whose_subtasks_depend_on_each_other(goal: str, first: str, then: str) -> None:
+    plan = next(g for g in GOALS if g.name == goal).plan(goal)
+    moved = [st.args.get("obj") for st in plan.subtasks]
+    targets = [st.args.get("target") for st in plan.subtasks]
+    assert first in moved and then in moved
+    i = moved.index(first)
+    later = moved[i + 1:] + targets[i + 1:]
+    assert first in later or targets[i] in later  # a later subtask acts on what this one built
 
 
 @pytest.mark.parametrize("text, goal", [

@@ -34,16 +34,22 @@ def _obj(name: str, type_: str, color: str | None = None) -> PlanObject:
     return PlanObject(name=name, type=type_, color=color)
 
 
-def put_on(obj: str, target: str, text: str) -> Subtask:
+def put_on(obj: str, target: str, text: str, also: tuple[Predicate, ...] = ()) -> Subtask:
+    """``obj`` on ``target`` and released; ``also``: what must still hold (e.g. what it carries)."""
     return Subtask(skill="pick_and_place", args={"obj": obj, "target": target}, description=text,
                    predicates=(Predicate(name="on", args=(obj, target)),
-                               Predicate(name="released", args=(obj,))))
+                               Predicate(name="released", args=(obj,)), *also))
 
 
-def put_in(obj: str, target: str, text: str) -> Subtask:
+def put_in(obj: str, target: str, text: str, also: tuple[Predicate, ...] = ()) -> Subtask:
     return Subtask(skill="pick_and_place", args={"obj": obj, "target": target}, description=text,
                    predicates=(Predicate(name="inside", args=(obj, target)),
-                               Predicate(name="released", args=(obj,))))
+                               Predicate(name="released", args=(obj,)), *also))
+
+
+def holds(name: str, *args: str) -> Predicate:
+    """A predicate a later subtask keeps checking (a stack that must survive being moved)."""
+    return Predicate(name=name, args=args)
 
 
 def press(obj: str, text: str, point: str | None = None) -> Subtask:
@@ -145,4 +151,101 @@ GOALS: tuple[Goal, ...] = (
          (put_in("small", "large", "the smaller bowl is nested inside the larger one"),
           put_on("cup", "coaster", "the cup stands on the coaster"),
           put_in("bread", "basket", "the bread is put away in the basket"))),
+    # -- goals of 4 to 6 subtasks, and goals whose subtasks depend on each other ----------------------
+    Goal("raise_a_skyscraper",
+         ("raise a skyscraper", "put up a block skyscraper", "erect a skyscraper",
+          "a skyscraper of blocks"),
+         (_obj("first", "block", "red"), _obj("second", "block", "green"), _obj("third", "block", "blue"),
+          _obj("fourth", "block", "yellow"), _obj("bell", "bell")),
+         (put_on("second", "first", "the green block is stacked on the red block"),
+          put_on("third", "second", "the blue block is stacked on the green block"),
+          put_on("fourth", "third", "the yellow block tops the four-block skyscraper"),
+          press("bell", "the bell is rung to show the skyscraper stands"))),
+    Goal("nest_and_stow",
+         ("nest and stow", "nest them and stow them on the plate", "stow the nested set away",
+          "nest and stow the set"),
+         (PlanObject(name="small", type="bowl", scale=0.85), PlanObject(name="large", type="bowl", scale=1.0),
+          _obj("plate", "plate"), _obj("bell", "bell")),
+         (put_in("small", "large", "the smaller bowl is nested in the larger one"),
+          # depends on the first: the larger bowl is carried with the smaller one nested in it
+          put_on("large", "plate", "the nested bowls are moved onto the plate together"),
+          press("bell", "the bell is rung once the bowls are stowed"))),
+    Goal("weigh_the_fruit",
+         ("weigh the fruit", "weigh the apple and the orange", "put the fruit on the scale one by one",
+          "check what the fruit weighs"),
+         (_obj("apple", "apple"), _obj("orange", "orange"), _obj("scale", "kitchen_scale"),
+          _obj("bowl", "bowl"), _obj("bell", "bell")),
+         (put_on("apple", "scale", "the apple is weighed on the kitchen scale"),
+          put_in("apple", "bowl", "the weighed apple is put into the bowl"),
+          put_on("orange", "scale", "the orange is weighed on the now free scale"),
+          press("bell", "the bell is rung when the weighing is done"))),
+    Goal("morning_routine",
+         ("do the morning routine", "start my morning routine", "wake up routine",
+          "run through my morning routine"),
+         (_obj("clock", "alarm_clock"), _obj("cup", "cup"), _obj("coaster", "coaster"),
+          _obj("phone", "phone"), _obj("stand", "phone_stand"), _obj("bell", "bell")),
+         (press("clock", "the alarm clock is silenced"),
+          put_on("cup", "coaster", "the cup stands on the coaster"),
+          put_on("phone", "stand", "the phone rests on its stand"),
+          press("bell", "the bell is rung for breakfast"),
+          press("clock", "the alarm is set again for tomorrow"))),
+    Goal("finish_the_shift",
+         ("finish the shift", "wrap up the shift", "end of shift routine", "close out the shift"),
+         (_obj("seal", "seal"), _obj("mat", "stamp_mat"), _obj("stapler", "stapler"),
+          _obj("mouse", "mouse"), _obj("pad", "mouse_pad"), _obj("phone", "phone"),
+          _obj("stand", "phone_stand"), _obj("bell", "bell")),
+         (put_on("seal", "mat", "the seal is stamped onto the mat"),
+          press("stapler", "the stapler is pressed down"),
+          put_on("mouse", "pad", "the mouse lies on the mouse pad"),
+          put_on("phone", "stand", "the phone is put on its stand"),
+          press("bell", "the bell is rung to end the shift"))),
+    Goal("fast_food_order",
+         ("fast food order", "serve a fast food order", "get the fast food ready",
+          "a burger and fries to go"),
+         (_obj("burger", "burger"), _obj("plate", "plate"), _obj("fries", "fries"),
+          _obj("basket", "basket"), _obj("bell", "bell")),
+         (put_on("burger", "plate", "the burger is on the plate"),
+          put_in("fries", "basket", "the fries are in the basket"),
+          press("bell", "the bell is rung: order up"))),
+    Goal("sort_the_recycling",
+         ("sort the recycling", "recycle the bottle and the can", "deal with the recycling",
+          "throw away the empties"),
+         (_obj("bottle", "bottle"), _obj("bin", "dustbin"), _obj("can", "can"),
+          _obj("box", "plastic_box"), _obj("switch", "switch")),
+         (put_in("bottle", "bin", "the bottle is in the dustbin"),
+          put_in("can", "box", "the can is in the plastic box"),
+          press("switch", "the switch is flipped", point="on"))),
+    Goal("tidy_the_hallway",
+         ("tidy the hallway", "put my shoe away in the hallway", "clear the entryway",
+          "tidy the entrance hall"),
+         (_obj("shoe", "shoe"), _obj("box", "shoe_box"), _obj("phone", "phone"),
+          _obj("stand", "phone_stand"), _obj("switch", "switch")),
+         (put_in("shoe", "box", "the shoe is in the shoe box"),
+          put_on("phone", "stand", "the phone rests on its stand"),
+          press("switch", "the hall light switch is flipped", point="on"))),
+    Goal("medicine_time",
+         ("time for my medicine", "time for my pills", "get my medication ready", "bring my pills and water"),
+         (_obj("pills", "pill_bottle"), _obj("plate", "plate"), _obj("cup", "cup"),
+          _obj("coaster", "coaster"), _obj("bell", "bell")),
+         (put_on("pills", "plate", "the pill bottle is on the plate"),
+          put_on("cup", "coaster", "the cup of water stands on the coaster"),
+          press("bell", "the bell is rung: medicine is ready"))),
+    Goal("cool_down_the_room",
+         ("cool down the room", "set up the fan", "it is too hot in here", "turn on the fan"),
+         (_obj("fan", "fan"), _obj("pad", "mouse_pad"), _obj("switch", "switch"), _obj("cup", "cup"),
+          _obj("coaster", "coaster")),
+         (put_on("fan", "pad", "the fan stands on the pad", also=(holds("upright", "fan"),)),
+          press("switch", "the fan's switch is flipped on", point="on"),
+          put_on("cup", "coaster", "a cold drink stands on the coaster"))),
+    Goal("block_city",
+         ("block city", "lay out a block city", "play block city", "set out a little block city"),
+         (_obj("red", "block", "red"), _obj("green", "block", "green"), _obj("blue", "block", "blue"),
+          _obj("orange", "block", "orange"), _obj("yellow", "block", "yellow"),
+          _obj("purple", "block", "purple"), _obj("bell", "bell")),
+         (press("bell", "the bell is rung to start building"),
+          put_on("green", "red", "the green block is stacked on the red block"),
+          put_on("blue", "green", "the blue block tops the first three-block building"),
+          put_on("yellow", "orange", "the yellow block is stacked on the orange block"),
+          put_on("purple", "yellow", "the purple block tops the second three-block building"),
+          press("bell", "the bell is rung: the block city is finished"))),
 )

@@ -34,6 +34,11 @@ ALIASES = {
     "loaf": "bread", "mobile": "phone", "cell phone": "phone", "service bell": "bell",
     "ball": "tennis_ball", "car": "toy_car", "glue": "glue_stick", "card": "playing_card",
     "cereal": "cereal_box", "rubiks cube": "rubik_cube", "rubik": "rubik_cube", "rubiks": "rubik_cube",
+    "rolling pin": "roller", "qr code": "qr_board", "qr board": "qr_board", "deck": "card_deck",
+    "deck of cards": "card_deck", "pill": "pill_bottle", "medicine bottle": "pill_bottle",
+    "french fries": "fries", "hamburger": "burger", "sneaker": "shoe", "trash can": "dustbin",
+    "trash bin": "dustbin", "bin": "dustbin", "scale": "kitchen_scale", "mug rack": "mug_rack",
+    "rack": "mug_rack", "desk fan": "fan",
 }
 # a name that may denote more than one type: a plan containing either covers it; in a step the
 # first is meant unless the context says otherwise (a phone's stand is the phone stand)
@@ -48,7 +53,7 @@ PREPOSITIONS = frozenset({"on", "in", "into", "onto", "inside", "with", "from", 
                           "beside", "by", "at", "over", "next", "behind"})
 # catalog nouns that are also verbs: objects only where an object can stand (see the module doc)
 VERBISH = frozenset({"can", "switch", "stamp", "seal", "tape", "block", "book", "stand", "box", "phone",
-                     "dice", "pot", "mat"})
+                     "dice", "pot", "mat", "hammer", "fan", "scale", "shoe", "bin", "deck", "rack"})
 _IRREGULAR_PLURALS = {"mouse": "mice"}
 
 

@@ -11,7 +11,7 @@ import numpy as np
 
 from vcage.assets.catalog import CATALOG
 from vcage.errors import SkillError
-from vcage.geometry import yaw_of
+from vcage.geometry import rot_z, yaw_of
 from vcage.sim.robot import HOME_QPOS
 from vcage.skills.base import (
     APPROACH,
@@ -110,6 +110,12 @@ def place(s: Skills, obj: str, target: str | None = None, placement: str | None 
         raise SkillError("place needs a target object or a table position xy")
     offset = _held_offset(s, obj) if offset is None else np.asarray(offset)
     hand_yaw = s.tcp()[1] if yaw is None else s.natural_yaw(yaw)
+    return _lower_and_release(s, surface, offset, hand_yaw, clearance)
+
+
+def _lower_and_release(s: Skills, surface: np.ndarray, offset: np.ndarray, hand_yaw: float,
+                       clearance: float) -> MotionPlan:
+    """Carry the held object above ``surface``, lower it onto it, release and withdraw."""
     goal = surface - offset + [0.0, 0.0, clearance]
     goal[2] = max(goal[2], s.table_z + TCP_MIN_ABOVE_TABLE)
     wps = s.transit(s.q, goal + [0.0, 0.0, APPROACH], hand_yaw, CLOSED)
@@ -184,3 +190,50 @@ def rotate(s: Skills, angle: float) -> MotionPlan:
     pos, yaw = s.tcp()
     q = s.ik.solve(pos, down_rotation(yaw + angle), s.q)
     return MotionPlan("rotate", (Waypoint(q, s.gripper, max(0.5, abs(angle) / 1.0), label="rotate"),))
+
+
+# -- additions for the RoboTwin-style tasks: turning while carrying, straight moves, shaking -------
+@SKILLS.register("turn_and_place")
+def turn_and_place(s: Skills, obj: str, turn: float, target: str | None = None,
+                   placement: str | None = None, xy: tuple[float, float] | None = None,
+                   clearance: float = 0.012) -> MotionPlan:
+    """Put the held ``obj`` down like :func:`place`, turned by ``turn`` radians about the vertical
+    (the hand turns by exactly that much, so the object's heading changes by ``turn``)."""
+    if target is not None:
+        surface, _ = placement_target(s, target, placement)
+    elif xy is not None:
+        surface = np.array([xy[0], xy[1], s.table_z])
+    else:
+        raise SkillError("turn_and_place needs a target object or a table position xy")
+    _, hand_yaw = s.tcp()
+    offset = rot_z(turn) @ _held_offset(s, obj)  # the object turns about the TCP with the hand
+    return MotionPlan("turn_and_place",
+                      _lower_and_release(s, surface, offset, hand_yaw + turn, clearance).waypoints)
+
+
+@SKILLS.register("move_line")
+def move_line(s: Skills, pos: np.ndarray, speed: float = SLOW_SPEED, hold: float = 0.0) -> MotionPlan:
+    """Move the TCP on a straight line to ``pos``, keeping its heading and the gripper as they are
+    (to strike, pull or slide in contact); ``hold`` keeps the end pose that many seconds."""
+    _, yaw = s.tcp()
+    wps = s.line(s.q, np.asarray(pos, float), yaw, s.gripper, speed, "line")
+    if hold > 0:
+        wps[-1] = Waypoint(wps[-1].q, wps[-1].gripper, wps[-1].duration, hold=hold, label="line")
+    return MotionPlan("move_line", tuple(wps))
+
+
+@SKILLS.register("shake")
+def shake(s: Skills, amplitude: float = 0.04, cycles: int = 3, heading: float = math.pi / 2,
+          speed: float = 0.25) -> MotionPlan:
+    """Shake the hand (and what it holds) ``cycles`` times by ``amplitude`` either way along the
+    horizontal direction ``heading`` (radians from +x; default along y), ending where it started."""
+    if amplitude <= 0 or cycles < 1:
+        raise SkillError("shake needs a positive amplitude and at least one cycle")
+    pos, yaw = s.tcp()
+    d = np.array([math.cos(heading), math.sin(heading), 0.0]) * amplitude
+    wps: list[Waypoint] = []
+    q = s.q
+    for target in [pos + d, pos - d] * cycles + [pos]:
+        wps += s.line(q, target, yaw, s.gripper, speed, "shake")
+        q = wps[-1].q
+    return MotionPlan("shake", tuple(wps))

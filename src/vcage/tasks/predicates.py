@@ -14,6 +14,7 @@ import numpy as np
 from vcage.assets.catalog import CATALOG
 from vcage.geometry import tilt_of
 from vcage.registry import Registry
+from vcage.scene.spec import ROBOT_MOUNT
 from vcage.sim.world import World
 
 XY_TOL = 0.01  # slack beyond a placement region's edge
@@ -139,6 +140,18 @@ def pressed(world: World, obj: str, point: str | None = None) -> bool:
 def moved(world: World, obj: str, start_xy: np.ndarray, distance: float) -> bool:
     return bool(np.linalg.norm(world.object_pos(obj)[:2] - np.asarray(start_xy)[:2]) >= distance)
 
+
+def facing(world: World, obj: str, point: str | None = None, tol: float = 0.45) -> bool:
+    """``obj``'s functional point faces the robot: its outward ``direction``, turned with the
+    object, points at the robot's base within ``tol`` radians (in the horizontal plane)."""
+    inst = world.object(obj)
+    fp = CATALOG.get(inst.type_name).functional_point(point)
+    out = (world.object_mat(obj) @ np.asarray(fp.direction, float))[:2]
+    to_robot = np.asarray(ROBOT_MOUNT[:2]) - world.object_pos(obj)[:2]
+    if np.linalg.norm(out) < 1e-6:
+        return False
+    cos = float(out @ to_robot) / (float(np.linalg.norm(out)) * float(np.linalg.norm(to_robot)))
+    return bool(cos >= np.cos(tol))
 
 
 # -- the oracle's check of each predicate of the vocabulary, with the default parameters ----------

@@ -1,15 +1,30 @@
-"""Reusable task shapes: move one object onto/into another, and press a functional point.
+"""Reusable task shapes: move one object onto/into another, press a functional point, and lift
+an object and hold it up.
 
 Concrete tasks subclass these and only declare their objects, words and instructions.
 """
 
 from __future__ import annotations
 
-from typing import ClassVar
+from typing import Any, ClassVar
 
+from vcage.geometry import wrap_angle, yaw_of
 from vcage.planning.schema import Predicate
+from vcage.sim.world import World
 from vcage.skills.base import Skills
+from vcage.tasks import predicates as P
 from vcage.tasks.base import AtomicTask, pred
+
+
+def heading(world: World, obj: str) -> float:
+    """``obj``'s yaw in the world."""
+    return yaw_of(world.object_mat(obj))
+
+
+def turn_to_align(world: World, obj: str, host: str) -> float:
+    """The smallest turn (within ±pi/2) that lines ``obj`` up with ``host``'s axes (mod pi)."""
+    d = wrap_angle(heading(world, host) - heading(world, obj))
+    return wrap_angle(2 * d) / 2
 
 
 class PlaceTask(AtomicTask):
@@ -19,6 +34,7 @@ class PlaceTask(AtomicTask):
     target: ClassVar[str]
     relation: ClassVar[str] = "on"  # "on" | "inside"
     need_upright: ClassVar[bool] = False
+    align: ClassVar[bool] = False  # turn ``obj`` on the way so its axes line up with ``target``'s
 
     def words(self) -> dict[str, str]:
         assert self.spec is not None
@@ -27,7 +43,13 @@ class PlaceTask(AtomicTask):
                 "obj_color": self.color_of(self.obj), "target_color": self.color_of(self.target)}
 
     def expert(self, skills: Skills) -> None:
-        skills.do("pick_and_place", obj=self.obj, target=self.target)
+        if self.align:  # a long object into a tight rectangular container
+            skills.do("grasp", obj=self.obj)
+            skills.do("lift")
+            skills.do("turn_and_place", obj=self.obj, target=self.target,
+                      turn=turn_to_align(skills.world, self.obj, self.target))
+        else:
+            skills.do("pick_and_place", obj=self.obj, target=self.target)
         skills.do("retreat")
 
     def success(self) -> tuple[Predicate, ...]:
@@ -47,3 +69,26 @@ class PressTask(AtomicTask):
 
     def success(self) -> tuple[Predicate, ...]:
         return (pred("pressed", self.obj), pred("upright", self.obj))
+
+
+class LiftTask(AtomicTask):
+    """Grasp ``obj`` and hold it up, level: lifted and upright (predicates) while still held."""
+
+    obj: ClassVar[str]
+    height: ClassVar[float] = 0.12
+    grasp_name: ClassVar[str | None] = None
+
+    def words(self) -> dict[str, str]:
+        return {"obj_color": self.color_of(self.obj)}
+
+    def expert(self, skills: Skills) -> None:
+        skills.do("grasp", obj=self.obj, grasp_name=self.grasp_name)
+        skills.do("lift", height=self.height)
+
+    def success(self) -> tuple[Predicate, ...]:
+        return pred("lifted", self.obj), pred("upright", self.obj)
+
+    def evaluate(self, world: World) -> dict[str, Any]:
+        values = super().evaluate(world)
+        held = P.grasped(world, self.obj)
+        return {**values, "success": values["success"] and held, "held": held}

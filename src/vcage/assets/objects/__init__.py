@@ -1,3 +1,3 @@
 """Built-in object types; importing this package registers them in ``CATALOG``."""
 
-from vcage.assets.objects import blocks, containers, devices, kitchen, office  # noqa: F401
+from vcage.assets.objects import blocks, containers, devices, household, kitchen, office, tools  # noqa: F401

@@ -8,4 +8,4 @@ from vcage.tasks.templates import PlaceTask
 class PlaceBreadBasket(PlaceTask):
     instructions = ("put the bread in the basket", "place the loaf of bread into the {target_color} basket")
     items = (Item("bread", "bread", (0.48, -0.16)), Item("basket", "basket", (0.55, 0.14)))
-    obj, target, relation = "bread", "basket", "inside"
+    obj, target, relation, align = "bread", "basket", "inside", True
