@@ -45,15 +45,7 @@ def plan_layout(plan: Plan, rng: np.random.Generator, rand: Randomization, clutt
         scale, color, friction = object_look(o.type, rng, rand, (o.color,) if o.color else None)
         looks[o.name] = (o.scale if o.scale is not None else scale, color, friction)
     grasped = {str(st.args["obj"]) for st in plan.subtasks if st.skill in GRASPING_SKILLS}
-    types = {o.name: o.type for o in plan.objects}
-    receives: dict[str, tuple[float, str | None]] = {}
-    for st in plan.subtasks:  # what is put on or in a target needs room there, hand included
-        target = st.args.get("target")
-        if st.skill == "pick_and_place" and target is not None:
-            held = str(st.args["obj"])
-            room = carry_radius(types[held], looks[held][0])
-            receives[str(target)] = (max(room, receives.get(str(target), (0.0, None))[0]),
-                                     st.args.get("placement"))
+    receives = _room_needed(plan, {name: look[0] for name, look in looks.items()})
     objects = []
     for o in _largest_first(plan):
         scale, color, friction = looks[o.name]
@@ -62,10 +54,10 @@ def plan_layout(plan: Plan, rng: np.random.Generator, rand: Randomization, clutt
         placed = scene.object(o.name) if scene is not None and not o.on else None
         if placed is not None:
             region, yaw = _nominal(placed, rand)
+        room, room_at = receives.get(o.name, (0.0, None))
         objects.append(LayoutObject(o.name, o.type, support=support, region=region, yaw=yaw, scale=scale,
                                     color=color, friction=friction, grasped=o.name in grasped,
-                                    receives=receives.get(o.name, (0.0, None))[0],
-                                    receives_at=receives.get(o.name, (0.0, None))[1]))
+                                    receives=room, receives_at=room_at))
     relations = tuple(Relation(r.kind, r.a, r.b, r.distance) for r in plan.relations)
     reserved = tuple(
         ReservedZone(f"subtask{i}", Region((float(st.args["xy"][0]), float(st.args["xy"][1])),
@@ -73,6 +65,22 @@ def plan_layout(plan: Plan, rng: np.random.Generator, rand: Randomization, clutt
         for i, st in enumerate(plan.subtasks) if st.args.get("xy") is not None)
     return LayoutSpec(objects=tuple(objects), relations=relations, reserved=reserved,
                       distractors=Distractors(clutter), **environment(rng, rand))
+
+
+def _room_needed(plan: Plan, scales: dict[str, float]) -> dict[str, tuple[float, str | None]]:
+    """For each target something is put on or in: the room the hand needs there (the largest
+    :func:`~vcage.scene.placement.geometry.carry_radius` of what goes there) and its placement."""
+    types = {o.name: o.type for o in plan.objects}
+    out: dict[str, tuple[float, str | None]] = {}
+    for st in plan.subtasks:
+        target = st.args.get("target")
+        if st.skill != "pick_and_place" or target is None:
+            continue
+        held = str(st.args["obj"])
+        room = carry_radius(types[held], scales[held])
+        if room > out.get(str(target), (0.0, None))[0]:
+            out[str(target)] = (room, st.args.get("placement"))
+    return out
 
 
 def _nominal(placed: PlacedObject, rand: Randomization) -> tuple[Region, tuple[float, float]]:
