@@ -83,7 +83,7 @@ class LLMPlanner:
         for _ in range(self.max_repairs + 1):
             reply = self.backend.chat(messages, json_mode=True)
             try:
-                data = json.loads(_strip_fences(reply))
+                data = json.loads(strip_fences(reply))
                 if not isinstance(data, dict):
                     raise ValueError(f"the reply is a JSON {type(data).__name__}, not an object")
                 data["instruction"] = text
@@ -95,7 +95,7 @@ class LLMPlanner:
                     raise ValueError(f"the instruction names {', '.join(missing)}, but the plan has no "
                                      "such object; every object the instruction names must be in the plan")
             except (ValueError, ValidationError) as exc:
-                errors = _describe(exc)
+                errors = describe_problems(exc)
             else:
                 return self._capped(plan)
             messages += [Message("assistant", reply),
@@ -117,15 +117,17 @@ class LLMPlanner:
         return plan
 
 
-def _strip_fences(text: str) -> str:
+def strip_fences(text: str) -> str:
+    """A model's reply without the Markdown code fence it may wrap JSON in."""
     m = re.search(r"```(?:json)?\s*(.*?)```", text, re.S)
     return m.group(1) if m else text.strip()
 
 
-def _describe(exc: Exception) -> str:
+def describe_problems(exc: Exception, root: str = "plan", limit: int = 8) -> str:
+    """What is wrong with a reply, in words a model can act on (``root`` names the whole reply)."""
     if isinstance(exc, ValidationError):
-        return "; ".join(f"{'.'.join(str(p) for p in e['loc']) or 'plan'}: {e['msg']}"
-                         for e in exc.errors()[:8])
+        return "; ".join(f"{'.'.join(str(p) for p in e['loc']) or root}: {e['msg']}"
+                         for e in exc.errors()[:limit])
     if isinstance(exc, json.JSONDecodeError):
         return f"not valid JSON ({exc.msg} at line {exc.lineno} column {exc.colno})"
     return str(exc)

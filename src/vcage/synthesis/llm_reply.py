@@ -10,13 +10,13 @@ caller raises its stage's typed error.
 from __future__ import annotations
 
 import json
-import re
 from collections.abc import Callable
 from typing import Any, TypeVar
 
 from pydantic import ValidationError
 
 from vcage.backends import ChatBackend, Message
+from vcage.planning.llm import describe_problems, strip_fences
 from vcage.synthesis.errors import SynthesisError
 
 T = TypeVar("T")
@@ -33,19 +33,9 @@ class ReplyRejected(SynthesisError):  # noqa: N818 - what happened to the replie
         self.replies = replies
 
 
-def strip_fences(text: str) -> str:
-    m = re.search(r"```(?:json)?\s*(.*?)```", text, re.S)
-    return m.group(1) if m else text.strip()
-
-
 def problems(exc: Exception) -> str:
     """What is wrong, in words a model can act on."""
-    if isinstance(exc, ValidationError):
-        return "; ".join(f"{'.'.join(str(p) for p in e['loc']) or 'reply'}: {e['msg']}"
-                         for e in exc.errors()[:MAX_PROBLEMS])
-    if isinstance(exc, json.JSONDecodeError):
-        return f"not valid JSON ({exc.msg} at line {exc.lineno} column {exc.colno})"
-    return str(exc)
+    return describe_problems(exc, root="reply", limit=MAX_PROBLEMS)
 
 
 def ask_json(backend: ChatBackend, messages: list[Message], check: Callable[[dict[str, Any]], T],
