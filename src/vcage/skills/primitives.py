@@ -152,7 +152,11 @@ def press(s: Skills, obj: str, point: str | None = None, depth: float = 0.004,
     # the closed finger tips are FINGER_REACH below the TCP
     contact = top + [0.0, 0.0, FINGER_REACH]
     bottom = contact - [0.0, 0.0, fp.stroke * inst.scale + depth]
-    yaw = s.natural_yaw(yaw_of(rot) + math.pi / 2)
+    # A round push button is the same from every side: the hand keeps its heading rather than turn
+    # the wrist by up to 90 degrees on the object's yaw, which says nothing about the button (and
+    # would make demonstrations differ by a wrist turn that a policy cannot read off the scene).
+    # Levers and switches are pressed across their axis.
+    yaw = s.tcp()[1] if fp.kind == "button" else s.natural_yaw(yaw_of(rot) + math.pi / 2)
     wps = [Waypoint(s.q, CLOSED, 0.3, label="close")]
     wps += s.transit(wps[-1].q, contact + [0.0, 0.0, 0.06], yaw, CLOSED)
     wps += s.line(wps[-1].q, bottom, yaw, CLOSED, 0.08, "press")
