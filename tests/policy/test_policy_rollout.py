@@ -75,10 +75,11 @@ def test_the_runner_predicts_every_eight_steps_from_a_two_frame_window(checkpoin
         obs, *_ = env.step(actions[-1])
     assert len(seen) == 3  # steps 0, 8 and 16
     first = seen[0][0]
-    assert first.shape == (2, 22) and torch.equal(first[0], first[1])  # the first frame, repeated
-    norm = runner.obs_norm
+    # the first frame, repeated; two quaternions read as 6 rotation-matrix values each
+    assert first.shape == (2, 26) and torch.equal(first[0], first[1])
+    norm, encode = runner.obs_norm, runner.encoder
     torch.testing.assert_close(seen[1][0], torch.from_numpy(np.stack(
-        [norm.normalize(np.full(22, 7.0)), norm.normalize(np.full(22, 8.0))])))
+        [norm.normalize(encode(np.full(22, 7.0))), norm.normalize(encode(np.full(22, 8.0)))])))
     expected = runner.action_norm.unnormalize(chunk[0, 1:9].numpy())  # from the current frame on
     np.testing.assert_allclose(np.stack(actions[:8]), expected, rtol=1e-6)
     np.testing.assert_allclose(actions[8], expected[0], rtol=1e-6)

@@ -26,6 +26,8 @@ def train_cmd(
         obs: str = typer.Option(None, help="comma-separated observation features (default: "
                                 "observation.state, observation.ee_pose and observation.environment_state "
                                 "if the dataset has it)"),
+        rotations: str = typer.Option(None, help="how the policy reads quaternions: rot6d (default: "
+                                      "rotation-matrix columns, continuous) or quaternion (as stored)"),
         resume: bool = typer.Option(False, help="continue the run in OUT from its last checkpoint (only "
                                     "--steps may change)"),
         device: str = typer.Option("cpu", help="cpu, or cuda when a GPU is present"),
@@ -37,7 +39,7 @@ def train_cmd(
     from vcage.policy.train import stored_config, train
 
     given: dict[str, Any] = {"policy": policy, "steps": steps, "batch_size": batch_size, "lr": lr,
-                             "seed": seed, "checkpoint_every": checkpoint_every,
+                             "seed": seed, "checkpoint_every": checkpoint_every, "rotations": rotations,
                              "observation_keys": tuple(k.strip() for k in obs.split(",") if k.strip())
                              if obs else None}
     given = {k: v for k, v in given.items() if v is not None}

@@ -15,6 +15,7 @@ from typing import Any
 
 from vcage.config import from_fields
 from vcage.errors import ConfigError
+from vcage.policy.encoding import ROTATIONS
 
 POLICY_KINDS = ("diffusion", "mlp")
 OBS_NORMS = ("min_max", "mean_std")
@@ -90,6 +91,7 @@ class TrainConfig:
     checkpoint_every: int = 500
     observation_keys: tuple[str, ...] | None = None  # None: DEFAULT_OBSERVATIONS the dataset has
     obs_norm: str = "min_max"  # observations to [-1, 1] (min_max) or to zero mean, unit std (mean_std)
+    rotations: str = "rot6d"  # quaternions read as rotation-matrix columns (see vcage.policy.encoding)
     n_obs_steps: int = 2
     horizon: int = 16
     n_action_steps: int = 8
@@ -103,6 +105,8 @@ class TrainConfig:
             raise ConfigError(f"unknown policy {self.policy!r}; valid: {', '.join(POLICY_KINDS)}")
         if self.obs_norm not in OBS_NORMS:
             raise ConfigError(f"unknown obs_norm {self.obs_norm!r}; valid: {', '.join(OBS_NORMS)}")
+        if self.rotations not in ROTATIONS:
+            raise ConfigError(f"unknown rotations {self.rotations!r}; valid: {', '.join(ROTATIONS)}")
         for name in ("steps", "batch_size", "checkpoint_every", "n_obs_steps", "horizon", "n_action_steps"):
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, int) or value < 1:
@@ -136,4 +140,6 @@ class TrainConfig:
 
     @classmethod
     def from_dict(cls, data: Any) -> TrainConfig:
+        if isinstance(data, dict) and "rotations" not in data:  # written before the choice: raw quaternions
+            data = {**data, "rotations": "quaternion"}
         return from_fields(cls, data, diffusion=DiffusionConfig, mlp=MlpConfig)

@@ -16,6 +16,7 @@ import numpy as np
 from vcage.data.reader import DatasetReader
 from vcage.errors import DatasetError
 from vcage.policy.config import ACTION, DEFAULT_OBSERVATIONS, REQUIRED_OBSERVATIONS, TrainConfig
+from vcage.policy.encoding import ObservationEncoder
 from vcage.policy.errors import MissingFeatureError
 
 MIN_EPISODES = 2
@@ -62,7 +63,8 @@ class DatasetInfo:
 @dataclass(frozen=True, eq=False)
 class TrainingData:
     """All frames of a dataset: ``obs`` (N, obs_dim) float32 (the features of ``obs_features``
-    side by side), ``action`` (N, action_dim) float32, ``lengths`` of the episodes in order."""
+    side by side, as :class:`ObservationEncoder` gives them to the policy), ``action``
+    (N, action_dim) float32, ``lengths`` of the episodes in order."""
 
     obs: np.ndarray
     action: np.ndarray
@@ -121,8 +123,9 @@ def load_training_data(root: str | Path, config: TrainConfig) -> TrainingData:
             part.append(_vectors(frames[key], key, i, reader.root))
         actions.append(_vectors(frames[ACTION], ACTION, i, reader.root))
         lengths.append(len(actions[-1]))
-    obs = np.concatenate([np.concatenate(p) for p in obs_parts], axis=1)
     specs = tuple(_spec(reader, k) for k in keys)
+    raw = np.concatenate([np.concatenate(p) for p in obs_parts], axis=1)
+    obs = ObservationEncoder(specs, config.rotations)(raw)
     info = DatasetInfo(str(reader.root), fingerprint(reader), reader.fps, reader.num_episodes,
                        reader.total_frames, reader.config)
     return TrainingData(obs, np.concatenate(actions), tuple(lengths), specs, _spec(reader, ACTION), info,

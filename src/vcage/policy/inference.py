@@ -17,6 +17,7 @@ import torch
 
 from vcage.policy.config import TrainConfig
 from vcage.policy.dataset import FeatureSpec
+from vcage.policy.encoding import ObservationEncoder
 from vcage.policy.errors import PolicyError
 from vcage.policy.models import Policy, make_policy
 from vcage.policy.normalize import Normalizer
@@ -33,7 +34,8 @@ class PolicyRunner:
         self.obs_norm = Normalizer.from_dict(checkpoint["normalization"]["obs"])
         self.action_norm = Normalizer.from_dict(checkpoint["normalization"]["action"])
         self.device = torch.device(device)
-        obs_dim = sum(f.size for f in self.obs_features)
+        self.encoder = ObservationEncoder(self.obs_features, self.config.rotations)
+        obs_dim = self.encoder.size
         self.model: Policy = make_policy(self.config, obs_dim, self.action_feature.size)
         try:
             self.model.load_state_dict(checkpoint["ema"]["model"])
@@ -58,9 +60,9 @@ class PolicyRunner:
             self.generator.manual_seed(seed)
 
     def observation_vector(self, obs: Mapping[str, Any]) -> np.ndarray:
-        """The policy's observation features of an environment observation, side by side."""
-        return np.concatenate([np.asarray(obs[f.name], dtype=np.float32).reshape(-1)
-                               for f in self.obs_features])
+        """The policy's input for an environment observation: its features side by side, encoded."""
+        return self.encoder(np.concatenate([np.asarray(obs[f.name], dtype=np.float32).reshape(-1)
+                                            for f in self.obs_features]))
 
     def act(self, obs: Mapping[str, Any]) -> np.ndarray:
         """The action for this step of the episode, given the environment's observation."""

@@ -1,0 +1,88 @@
+"""How a policy reads quaternions: continuous, sign-blind rotation-matrix columns by default."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from conftest import tiny
+from vcage.errors import ConfigError
+from vcage.policy.config import TrainConfig
+from vcage.policy.dataset import FeatureSpec, load_training_data
+from vcage.policy.encoding import ObservationEncoder, quaternion_starts, rot6d
+
+EE_NAMES = ("x", "y", "z", "qw", "qx", "qy", "qz")
+FEATURES = (FeatureSpec("observation.state", 2, ("joint1", "gripper_width")),
+            FeatureSpec("observation.ee_pose", 7, EE_NAMES),
+            FeatureSpec("observation.environment_state", 14,
+                        tuple(f"{o}.{n}" for o in ("bell", "pad") for n in EE_NAMES)))
+
+
+def test_quaternions_are_found_by_their_element_names() -> None:
+    assert quaternion_starts(EE_NAMES) == [3]
+    assert quaternion_starts(FEATURES[2].names) == [3, 10]
+    assert quaternion_starts(("joint1", "joint2")) == [] and quaternion_starts(None) == []
+    # a run whose prefixes differ, or whose prefix is not an object name, is not a quaternion
+    assert quaternion_starts(("a.qw", "b.qx", "a.qy", "a.qz")) == []
+    assert quaternion_starts(("xqw", "xqx", "xqy", "xqz")) == []
+    assert quaternion_starts(("qx", "qw", "qy", "qz")) == []
+
+
+def test_rot6d_is_the_rotation_matrix_first_two_columns_and_blind_to_the_sign() -> None:
+    rng = np.random.default_rng(0)
+    q = rng.normal(size=(50, 4))
+    q /= np.linalg.norm(q, axis=1, keepdims=True)
+    np.testing.assert_allclose(rot6d(q), rot6d(-q), atol=1e-12)
+    half = np.pi / 6  # a turn of 60 degrees about z
+    np.testing.assert_allclose(rot6d(np.array([np.cos(half), 0, 0, np.sin(half)])),
+                               [0.5, np.sqrt(3) / 2, 0, -np.sqrt(3) / 2, 0.5, 0], atol=1e-12)
+
+
+def test_a_gripper_pointing_down_reads_the_same_across_the_stored_sign_flip() -> None:
+    """The end effector's stored quaternion jumps from (0, 1, 0, 0) to (0, -1, 0, 0) when w crosses
+    zero; the encoded input moves by the small rotation between the two frames only."""
+    encoder = ObservationEncoder(FEATURES[1:2], "rot6d")
+    before = np.array([0.4, 0.0, 1.1, 0.001, 1.0, 0.0, 0.01], dtype=np.float32)
+    # a frame later w is -0.001: stored with w >= 0, i.e. negated
+    after = np.array([0.4, 0.0, 1.1, 0.001, -1.0, 0.0, -0.01], dtype=np.float32)
+    assert np.abs(before - after).max() == pytest.approx(2.0)
+    assert np.abs(encoder(before) - encoder(after)).max() < 0.005
+    same = before.copy()
+    same[3:] *= -1  # -q: the same pose exactly
+    np.testing.assert_allclose(encoder(before), encoder(same), atol=1e-6)
+
+
+def test_the_encoder_keeps_every_other_value_in_place_and_grows_by_two_per_quaternion() -> None:
+    encoder = ObservationEncoder(FEATURES, "rot6d")
+    raw = np.arange(23, dtype=np.float32) / 23 + 0.1
+    out = encoder(np.stack([raw, raw]))
+    assert encoder.raw_size == 23 and encoder.size == 29 and out.shape == (2, 29) and out.dtype == np.float32
+    np.testing.assert_array_equal(out[0, :5], raw[:5])  # state, then the end effector's position
+    np.testing.assert_allclose(out[0, 5:11], rot6d(raw[5:9]), rtol=1e-6)
+    np.testing.assert_array_equal(out[0, 11:14], raw[9:12])  # the bell's position
+    np.testing.assert_array_equal(out[0, 20:23], raw[16:19])  # the pad's position
+    passthrough = ObservationEncoder(FEATURES, "quaternion")
+    assert passthrough.size == 23 and np.array_equal(passthrough(raw), raw)
+    with pytest.raises(ValueError, match="expected 23"):
+        encoder(raw[:-1])
+    with pytest.raises(ConfigError, match="rot6d"):
+        ObservationEncoder(FEATURES, "euler")
+
+
+def test_the_default_is_rot6d_and_configs_written_before_the_choice_read_quaternions() -> None:
+    assert TrainConfig().rotations == "rot6d"
+    legacy = TrainConfig().to_dict()
+    del legacy["rotations"]
+    assert TrainConfig.from_dict(legacy).rotations == "quaternion"
+    with pytest.raises(ConfigError, match="unknown rotations"):
+        TrainConfig(rotations="euler")
+
+
+def test_training_data_carries_the_encoded_observations(dataset: Path) -> None:
+    encoded = load_training_data(dataset, tiny("mlp"))
+    raw = load_training_data(dataset, tiny("mlp", rotations="quaternion"))
+    assert raw.obs.shape[1] == 22 and encoded.obs.shape[1] == 26  # two quaternions, 4 -> 6 values each
+    encoder = ObservationEncoder(raw.obs_features, "rot6d")
+    np.testing.assert_allclose(encoded.obs, encoder(raw.obs), rtol=1e-6)
