@@ -11,7 +11,8 @@ For each task of the suite (single-subtask instructions and long-horizon goals):
 3. train ``--policy`` on each dataset with each of ``--train-seeds`` seeds and the same budget;
 4. evaluate every checkpoint on the same held-out scenes, in the V-CAGE environment (both datasets
    share the plan, so the policies observe and act alike; Vanilla's own environment would sample
-   its unchecked scenes).
+   its unchecked scenes), and on ``--fit`` scenes of its own training episodes (column "fit"): a
+   policy that fails there cannot reproduce its demonstrations, whatever their labels.
 
 Then it prints, per task and method, the success rate (pooled over training seeds, Wilson 95%
 interval) and Vanilla's label noise; overall, Avg SR and Top-K SR computed two ways (the paper does
@@ -121,7 +122,17 @@ def train_and_evaluate(task: str, method: str, dataset: Path, env_config: dict[s
     evaluation = evaluate(run, len(scenes), seed=0, max_steps=args.max_steps, env_config=env_config,
                           threads=args.threads, make_env=functools.partial(make_env, scenes=scenes),
                           workers=args.workers)
+    fit = None
+    if args.fit:  # the same checkpoint on scenes of its own training episodes: does it fit its data?
+        from vcage.policy.checkpoint import load_checkpoint
+        from vcage.policy.evaluate import training_scenes
+
+        own = training_scenes(load_checkpoint(summary.checkpoint), args.fit)
+        fit = evaluate(run, len(own), seed=0, max_steps=args.max_steps, env_config=env_config,
+                       threads=args.threads, scenes=own, workers=args.workers)
     out = evaluation.to_dict() | {"task": task, "method": method, "train_seed": train_seed,
+                                  "fit": None if fit is None else {"episodes": len(fit.episodes),
+                                                                   "successes": fit.successes},
                                   "train_seconds": summary.seconds,
                                   "train_samples_per_second": summary.samples_per_second,
                                   "final_loss": summary.final_loss}
@@ -171,7 +182,7 @@ def report(results: list[dict[str, Any]], noise: dict[str, float], draws: int) -
     for r in results:
         by.setdefault(r["task"], {}).setdefault(r["method"], []).append(r)
     print(f"\n{'task':48s} {'method':8s} {'SR':>6s} {'Wilson 95%':>15s} {'n':>5s} {'progress':>9s} "
-          f"{'vanilla noise':>14s}")
+          f"{'fit':>9s} {'vanilla noise':>14s}")
     rates: dict[str, dict[str, list[float]]] = {m: {} for m in METHODS}
     outcomes: dict[str, dict[str, np.ndarray]] = {}
     for task, methods in by.items():
@@ -186,8 +197,11 @@ def report(results: list[dict[str, Any]], noise: dict[str, float], draws: int) -
             ordered = sorted(runs, key=lambda r: r["train_seed"])
             outcomes.setdefault(task, {})[method] = np.array(
                 [[e["success"] for e in r["per_episode"]] for r in ordered], dtype=float)
+            fits = [r["fit"] for r in runs if r.get("fit")]
+            fit = f"{sum(f['successes'] for f in fits)}/{sum(f['episodes'] for f in fits)}" if fits \
+                else "n/a"
             print(f"{task[:48]:48s} {method:8s} {s / n:6.1%} {f'[{low:.0%}, {high:.0%}]':>15s} {n:5d} "
-                  f"{progress:9.2f} {noise.get(task, float('nan')):14.1%}")
+                  f"{progress:9.2f} {fit:>9s} {noise.get(task, float('nan')):14.1%}")
     print(f"\n{'':14s} {'Avg SR':>8s} {'Top-5 (tasks)':>14s} {'Top-10 (tasks)':>15s} "
           f"{'Top-5 (ckpts)':>14s} {'Top-10 (ckpts)':>15s}")
     for method in METHODS:
@@ -226,13 +240,15 @@ def main() -> None:
     parser.add_argument("--threads", type=int, default=1, help="torch threads per process")
     parser.add_argument("--workers", type=int, default=1,
                         help="processes for generation and evaluation rollouts (same results as one)")
+    parser.add_argument("--fit", type=int, default=10,
+                        help="also roll out each checkpoint on this many of its own training scenes (0: no)")
     parser.add_argument("--bootstrap", type=int, default=2000)
     parser.add_argument("--quick", action="store_true", help="smoke path: tiny everything")
     args = parser.parse_args()
     if args.quick:
         args.tasks = args.tasks or list(QUICK_SUITE)
         args.demos, args.eval, args.train_seeds, args.steps = 2, 1, 1, 4
-        args.policy, args.max_steps, args.bootstrap = "mlp", 20, 50
+        args.policy, args.max_steps, args.bootstrap, args.fit = "mlp", 20, 50, 1
     tasks = args.tasks or list(SUITE)
     from vcage.pipeline.audit import audit
 

@@ -60,3 +60,34 @@ def test_bad_input_exits_2_with_the_reason(generated: Path, tmp_path: Path) -> N
     wrong = RUN.invoke(app, ["train", str(generated), "--out", str(tmp_path / "run"), "--policy", "gpt"])
     assert wrong.exit_code == 2 and "valid: diffusion, mlp" in flat(wrong.output)
     assert not (tmp_path / "run").exists()
+
+
+def test_evaluate_on_the_training_scenes_rolls_out_the_datasets_own_scenes(generated: Path,
+                                                                          tmp_path: Path) -> None:
+    from vcage.data import DatasetReader
+
+    out, report = tmp_path / "run", tmp_path / "eval.json"
+    trained = RUN.invoke(app, ["train", str(generated), "--policy", "mlp", "--out", str(out), "--steps", "2",
+                               "--batch-size", "8", "--threads", "1"])
+    assert trained.exit_code == 0, trained.output
+    result = RUN.invoke(app, ["evaluate", str(out), "--episodes", "3", "--max-steps", "4", "--training-scenes",
+                              "--json", str(report)])
+    assert result.exit_code == 0, result.output
+    assert "has 2 episodes" in flat(result.output) and "training (the dataset's own)" in flat(result.output)
+    reader = DatasetReader(generated)
+    record = json.loads(report.read_text())
+    seeds = [e["scene_seed"] for e in record["per_episode"]]
+    assert seeds == [reader.extras(i)["seed"] for i in range(2)]
+    held_out = RUN.invoke(app, ["evaluate", str(out), "--episodes", "1", "--max-steps", "4", "--json",
+                                str(report)])
+    assert held_out.exit_code == 0, held_out.output
+    assert json.loads(report.read_text())["per_episode"][0]["scene_seed"] not in seeds
+
+
+def test_training_scenes_need_a_dataset_that_stores_its_seeds(tmp_path: Path) -> None:
+    synthetic = write_dataset(tmp_path / "synthetic", 2)
+    out = tmp_path / "run"
+    assert RUN.invoke(app, ["train", str(synthetic), "--policy", "mlp", "--out", str(out), "--steps", "2",
+                            "--batch-size", "8", "--threads", "1"]).exit_code == 0
+    result = RUN.invoke(app, ["evaluate", str(out), "--episodes", "1", "--training-scenes"])
+    assert result.exit_code == 2 and "does not store its episodes' scene seeds" in flat(result.output)

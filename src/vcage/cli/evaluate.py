@@ -27,6 +27,9 @@ def evaluate_cmd(
         threads: int = typer.Option(None, min=1, help="torch CPU threads (default: torch's choice; 1 per "
                                     "worker with --workers)"),
         workers: int = typer.Option(1, min=1, help="processes sharing the episodes (same results as one)"),
+        training_scenes: bool = typer.Option(False, help="roll out on the scenes of the training dataset's "
+                                             "first --episodes episodes instead of held-out ones: does the "
+                                             "policy reproduce its own demonstrations?"),
         json_out: Path = typer.Option(None, "--json",
                                       help="also write the results to this JSON file")) -> None:
     """Roll out CHECKPOINT for --episodes episodes: success rate (Wilson 95% interval), progress per
@@ -34,13 +37,20 @@ def evaluate_cmd(
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
     from vcage.data import DatasetReader
+    from vcage.policy.checkpoint import load_checkpoint
     from vcage.policy.evaluate import evaluate
+    from vcage.policy.evaluate import training_scenes as scenes_of
 
     env_config = DatasetReader(env).config if env is not None else None
     if env is not None and not env_config:
         from vcage.errors import DatasetError
 
         raise DatasetError(f"{env} stores no vcage configuration (meta/vcage.json); choose a vcage dataset")
+    scenes = scenes_of(load_checkpoint(checkpoint), episodes) if training_scenes else None
+    if scenes is not None and len(scenes) < episodes:
+        console.print(f"[yellow]note:[/yellow] the training dataset has {len(scenes)} episodes: evaluating "
+                      "on those")
+        episodes = len(scenes)
     bar = Progress(TextColumn("{task.description}"), BarColumn(), TextColumn("{task.completed}/{task.total}"),
                    TimeElapsedColumn(), console=console)
     job = bar.add_task("episodes", total=episodes)
@@ -55,7 +65,7 @@ def evaluate_cmd(
 
     try:
         result = evaluate(checkpoint, episodes, seed=seed, max_steps=max_steps, env_config=env_config,
-                          device=device, threads=threads, progress=update, workers=workers)
+                          device=device, threads=threads, progress=update, workers=workers, scenes=scenes)
     finally:
         if bar.live.is_started:
             bar.stop()
@@ -70,6 +80,7 @@ def evaluate_cmd(
         name = result.subtask_names[i] if i < len(result.subtask_names) else ""
         table.add_row(f"subtask {i + 1} done{': ' + name if name else ''}", f"{share:.1%}")
     table.add_row("rollouts/minute", f"{result.rollouts_per_minute:.2f}")
+    table.add_row("scenes", "training (the dataset's own)" if scenes is not None else "held-out")
     table.add_row("seed", str(seed))
     console.print(table)
     if json_out is not None:

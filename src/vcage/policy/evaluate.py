@@ -8,8 +8,9 @@ against the environment's; a difference raises :class:`EnvironmentMismatchError`
 
 from __future__ import annotations
 
+import functools
 import time
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any
@@ -148,6 +149,27 @@ def rollout(runner: PolicyRunner, env: gym.Env, seed: int | None = None,
                          info.get("scene_seed"))
 
 
+def training_scenes(checkpoint: Mapping[str, Any], count: int) -> list[int]:
+    """The scene seeds of the first ``count`` episodes of the dataset ``checkpoint`` was trained on
+    (all of them if it has fewer): rolling out on them asks whether the policy reproduces its own
+    demonstrations, which tells a policy that cannot fit its data from one that does not generalise."""
+    from vcage.data.reader import DatasetReader
+    from vcage.errors import DatasetError
+
+    path = checkpoint["dataset"]["path"]
+    try:
+        reader = DatasetReader(path)
+        seeds = [reader.extras(i).get("seed") for i in range(min(count, reader.num_episodes))]
+    except DatasetError as exc:
+        raise PolicyError(f"the training scenes are those of the dataset the checkpoint was trained on, "
+                          f"and it cannot be read at {path} ({exc}); evaluate on held-out scenes") from None
+    found = [s for s in seeds if isinstance(s, int)]
+    if not found or len(found) < len(seeds):
+        raise PolicyError(f"the dataset {path} does not store its episodes' scene seeds (a dataset not "
+                          "written by vcage generate); evaluate on held-out scenes")
+    return found
+
+
 def default_factory() -> EnvFactory:
     from vcage.pipeline.evaluation import make_env
 
@@ -158,7 +180,7 @@ def evaluate(checkpoint: str | Path, episodes: int, *, seed: int = 0, max_steps:
              env_config: dict[str, Any] | None = None, device: str = "cpu", threads: int | None = None,
              make_env: EnvFactory | None = None,
              progress: Callable[[int, int, EpisodeResult], None] | None = None,
-             workers: int = 1) -> Evaluation:
+             workers: int = 1, scenes: Sequence[int] | None = None) -> Evaluation:
     """Roll out ``checkpoint`` (a file, or a training run's directory: its latest) for ``episodes``
     episodes of the environment of ``env_config`` (default: the configuration of the dataset it was
     trained on), seeded ``seed``; ``threads`` caps torch's CPU threads for the duration.
@@ -167,7 +189,8 @@ def evaluate(checkpoint: str | Path, episodes: int, *, seed: int = 0, max_steps:
     :func:`episode_noise_seed`, so ``workers`` processes (each rolling out its share, with
     ``threads`` torch threads, default 1) give the same episodes as one. More than one worker needs
     an environment that can start episode ``k`` directly (``episode_option``, as ``GoalEnv``) and a
-    picklable ``make_env``."""
+    picklable ``make_env``. ``scenes`` (scene seeds, e.g. :func:`training_scenes`) replaces the
+    environment's own evaluation scenes: episode ``k`` builds ``scenes[k % len(scenes)]``."""
     if episodes < 1:
         raise PolicyError(f"--episodes must be at least 1, got {episodes}")
     if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
@@ -180,6 +203,10 @@ def evaluate(checkpoint: str | Path, episodes: int, *, seed: int = 0, max_steps:
                           "vcage configuration (meta/vcage.json), so there is no environment to evaluate in; "
                           "pass the environment of a vcage dataset (--env DATASET)")
     factory = make_env or default_factory()
+    if scenes is not None:
+        if not scenes:
+            raise PolicyError("an evaluation on given scenes needs at least one scene seed")
+        factory = functools.partial(factory, scenes=list(scenes))
     env = factory(config, seed=seed, max_steps=max_steps)
     old_threads = torch.get_num_threads()
     if threads is not None:
