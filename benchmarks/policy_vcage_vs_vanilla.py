@@ -105,20 +105,56 @@ def solvable_scenes(task: str, dataset: Path, work: Path, count: int, base: int)
     return list(state["solved"][:count])
 
 
-def train_and_evaluate(task: str, method: str, dataset: Path, env_config: dict[str, Any], scenes: list[int],
-                       train_seed: int, args: argparse.Namespace, work: Path) -> dict[str, Any]:
-    from vcage.pipeline.evaluation import make_env
+def result_path(work: Path, task: str, method: str, train_seed: int) -> Path:
+    return work / "results" / slug(task) / method / f"seed{train_seed}.json"
+
+
+def run_dir(work: Path, task: str, method: str, train_seed: int) -> Path:
+    return work / "runs" / slug(task) / method / f"seed{train_seed}"
+
+
+def train_config(args: argparse.Namespace, train_seed: int) -> Any:
     from vcage.policy import TrainConfig
-    from vcage.policy.evaluate import evaluate
+
+    return TrainConfig(policy=args.policy, steps=args.steps, lr=args.lr, seed=train_seed,
+                       checkpoint_every=max(1, min(500, args.steps)))
+
+
+def train_run(dataset: Path, run: Path, config: Any, threads: int) -> tuple[float, float]:
+    """One training run (resumed if interrupted): its seconds and samples per second."""
     from vcage.policy.train import train
 
-    result_path = work / "results" / slug(task) / method / f"seed{train_seed}.json"
-    if result_path.is_file():
-        return dict(json.loads(result_path.read_text()))
-    run = work / "runs" / slug(task) / method / f"seed{train_seed}"
-    config = TrainConfig(policy=args.policy, steps=args.steps, seed=train_seed,
-                         checkpoint_every=max(1, min(500, args.steps)))
-    summary = train(dataset, run, config, resume=True, threads=args.threads)
+    summary = train(dataset, run, config, resume=True, threads=threads)
+    return summary.seconds, summary.samples_per_second
+
+
+def train_all(jobs: list[tuple[Path, Path, Any]], workers: int,
+              threads: int) -> dict[Path, tuple[float, float]]:
+    """The training runs of ``jobs`` (dataset, run directory, config), ``workers`` at a time in
+    spawned processes (training is single-threaded at these sizes: processes use the cores)."""
+    if workers <= 1 or len(jobs) <= 1:
+        return {run: train_run(dataset, run, config, threads) for dataset, run, config in jobs}
+    import multiprocessing
+    from concurrent.futures import ProcessPoolExecutor
+
+    spawn = multiprocessing.get_context("spawn")
+    with ProcessPoolExecutor(min(workers, len(jobs)), mp_context=spawn) as pool:
+        futures = {run: pool.submit(train_run, dataset, run, config, threads)
+                   for dataset, run, config in jobs}
+        return {run: future.result() for run, future in futures.items()}
+
+
+def train_and_evaluate(task: str, method: str, dataset: Path, env_config: dict[str, Any], scenes: list[int],
+                       train_seed: int, args: argparse.Namespace, work: Path,
+                       trained: tuple[float, float] | None = None) -> dict[str, Any]:
+    from vcage.pipeline.evaluation import make_env
+    from vcage.policy.evaluate import evaluate
+
+    path = result_path(work, task, method, train_seed)
+    if path.is_file():
+        return dict(json.loads(path.read_text()))
+    run = run_dir(work, task, method, train_seed)
+    seconds, rate = trained or train_run(dataset, run, train_config(args, train_seed), args.threads)
     evaluation = evaluate(run, len(scenes), seed=0, max_steps=args.max_steps, env_config=env_config,
                           threads=args.threads, make_env=functools.partial(make_env, scenes=scenes),
                           workers=args.workers)
@@ -127,18 +163,26 @@ def train_and_evaluate(task: str, method: str, dataset: Path, env_config: dict[s
         from vcage.policy.checkpoint import load_checkpoint
         from vcage.policy.evaluate import training_scenes
 
-        own = training_scenes(load_checkpoint(summary.checkpoint), args.fit)
+        own = training_scenes(load_checkpoint(run), args.fit)
         fit = evaluate(run, len(own), seed=0, max_steps=args.max_steps, env_config=env_config,
                        threads=args.threads, scenes=own, workers=args.workers)
     out = evaluation.to_dict() | {"task": task, "method": method, "train_seed": train_seed,
                                   "fit": None if fit is None else {"episodes": len(fit.episodes),
                                                                    "successes": fit.successes},
-                                  "train_seconds": summary.seconds,
-                                  "train_samples_per_second": summary.samples_per_second,
-                                  "final_loss": summary.final_loss}
-    result_path.parent.mkdir(parents=True, exist_ok=True)
-    result_path.write_text(json.dumps(out, indent=1))
+                                  "train_seconds": seconds, "train_samples_per_second": rate,
+                                  "final_loss": final_loss(run)}
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(json.dumps(out, indent=1))
     return out
+
+
+def final_loss(run: Path) -> float:
+    """The mean loss of the last steps of the run's latest checkpoint."""
+    from vcage.policy.checkpoint import load_checkpoint
+    from vcage.policy.train import LOSS_WINDOW
+
+    history = load_checkpoint(run)["loss_history"].tolist()[-LOSS_WINDOW:]
+    return float(np.mean(history)) if history else float("nan")
 
 
 def wilson(successes: int, n: int) -> tuple[float, float]:
@@ -233,13 +277,14 @@ def main() -> None:
     parser.add_argument("--eval", type=int, default=50, help="held-out scenes per task")
     parser.add_argument("--train-seeds", type=int, default=3)
     parser.add_argument("--policy", choices=("diffusion", "mlp"), default="diffusion")
-    parser.add_argument("--steps", type=int, default=3000, help="training steps per checkpoint run")
+    parser.add_argument("--steps", type=int, default=15000, help="training steps per checkpoint run")
+    parser.add_argument("--lr", type=float, default=1e-3, help="peak learning rate")
     parser.add_argument("--max-steps", type=int, default=None, help="evaluation episode length cap")
     parser.add_argument("--seed", type=int, default=0, help="generation run seed (both methods)")
     parser.add_argument("--size", type=int, default=64, help="video size (the policy is state-based)")
     parser.add_argument("--threads", type=int, default=1, help="torch threads per process")
     parser.add_argument("--workers", type=int, default=1,
-                        help="processes for generation and evaluation rollouts (same results as one)")
+                        help="processes for generation, training runs and rollouts (same results as one)")
     parser.add_argument("--fit", type=int, default=10,
                         help="also roll out each checkpoint on this many of its own training scenes (0: no)")
     parser.add_argument("--bootstrap", type=int, default=2000)
@@ -262,10 +307,14 @@ def main() -> None:
         from vcage.data import DatasetReader
 
         env_config = DatasetReader(datasets["vcage"]).config or {}
+        pending = [(m, s) for m in METHODS for s in range(args.train_seeds)
+                   if not result_path(args.work, task, m, s).is_file()]
+        jobs = [(datasets[m], run_dir(args.work, task, m, s), train_config(args, s)) for m, s in pending]
+        trained = train_all(jobs, args.workers, args.threads)
         for method in METHODS:
             for train_seed in range(args.train_seeds):
                 r = train_and_evaluate(task, method, datasets[method], env_config, scenes, train_seed, args,
-                                       args.work)
+                                       args.work, trained.get(run_dir(args.work, task, method, train_seed)))
                 print(f"  {method:8s} seed {train_seed}: SR {r['success_rate']:.1%} on {r['episodes']} "
                       f"scenes, {r['train_samples_per_second']:.0f} training samples/s, "
                       f"{r['rollouts_per_minute']:.1f} rollouts/min", flush=True)
