@@ -12,6 +12,7 @@ from typer.testing import CliRunner
 
 from conftest import write_dataset
 from vcage.cli import app
+from vcage.policy.checkpoint import load_checkpoint
 
 RUN = CliRunner()
 
@@ -70,8 +71,9 @@ def test_evaluate_on_the_training_scenes_rolls_out_the_datasets_own_scenes(gener
     trained = RUN.invoke(app, ["train", str(generated), "--policy", "mlp", "--out", str(out), "--steps", "2",
                                "--batch-size", "8", "--threads", "1"])
     assert trained.exit_code == 0, trained.output
-    result = RUN.invoke(app, ["evaluate", str(out), "--episodes", "3", "--max-steps", "4", "--training-scenes",
-                              "--json", str(report)])
+    assert load_checkpoint(out)["config"]["rotations"] == "rot6d"  # the default, when not chosen
+    result = RUN.invoke(app, ["evaluate", str(out), "--episodes", "3", "--max-steps", "4",
+                              "--training-scenes", "--json", str(report)])
     assert result.exit_code == 0, result.output
     assert "has 2 episodes" in flat(result.output) and "training (the dataset's own)" in flat(result.output)
     reader = DatasetReader(generated)

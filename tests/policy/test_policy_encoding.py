@@ -6,12 +6,16 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import torch
 
 from conftest import tiny
 from vcage.errors import ConfigError
+from vcage.policy.checkpoint import load_checkpoint
 from vcage.policy.config import TrainConfig
 from vcage.policy.dataset import FeatureSpec, load_training_data
 from vcage.policy.encoding import ObservationEncoder, quaternion_starts, rot6d
+from vcage.policy.inference import PolicyRunner
+from vcage.policy.train import train
 
 EE_NAMES = ("x", "y", "z", "qw", "qx", "qy", "qz")
 FEATURES = (FeatureSpec("observation.state", 2, ("joint1", "gripper_width")),
@@ -71,13 +75,22 @@ def test_the_encoder_keeps_every_other_value_in_place_and_grows_by_two_per_quate
         ObservationEncoder(FEATURES, "euler")
 
 
-def test_the_default_is_rot6d_and_configs_written_before_the_choice_read_quaternions() -> None:
+def test_the_default_is_rot6d_and_checkpoints_written_before_the_choice_read_quaternions(
+        dataset: Path, tmp_path: Path) -> None:
     assert TrainConfig().rotations == "rot6d"
-    legacy = TrainConfig().to_dict()
-    del legacy["rotations"]
-    assert TrainConfig.from_dict(legacy).rotations == "quaternion"
+    given = TrainConfig().to_dict()
+    del given["rotations"]  # a configuration that does not choose gets the default
+    assert TrainConfig.from_dict(given).rotations == "rot6d"
     with pytest.raises(ConfigError, match="unknown rotations"):
         TrainConfig(rotations="euler")
+    path = train(dataset, tmp_path / "run", tiny("mlp", steps=2, checkpoint_every=2,
+                                                 rotations="quaternion")).checkpoint
+    payload = torch.load(path, weights_only=True)
+    del payload["config"]["rotations"]  # as checkpoints were written before the choice
+    torch.save(payload, path)
+    old = load_checkpoint(path)
+    assert old["config"]["rotations"] == "quaternion"
+    assert PolicyRunner(old).encoder.size == 22  # its weights take the 22 stored values
 
 
 def test_training_data_carries_the_encoded_observations(dataset: Path) -> None:

@@ -102,5 +102,8 @@ def load_checkpoint(path: str | Path) -> dict[str, Any]:
     missing = [k for k in REQUIRED if k not in payload]
     if missing:
         raise CheckpointError(f"{path} lacks {', '.join(missing)}; it is damaged: train again")
+    if isinstance(payload["config"], dict) and "rotations" not in payload["config"]:
+        # written before policies chose how to read quaternions: they read them as stored
+        payload["config"] = {**payload["config"], "rotations": "quaternion"}
     payload["path"] = str(path)
     return payload

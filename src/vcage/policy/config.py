@@ -140,6 +140,4 @@ class TrainConfig:
 
     @classmethod
     def from_dict(cls, data: Any) -> TrainConfig:
-        if isinstance(data, dict) and "rotations" not in data:  # written before the choice: raw quaternions
-            data = {**data, "rotations": "quaternion"}
         return from_fields(cls, data, diffusion=DiffusionConfig, mlp=MlpConfig)
