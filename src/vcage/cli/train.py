@@ -18,11 +18,11 @@ def train_cmd(
         dataset: Path = typer.Argument(..., help="a dataset directory (LeRobot v3)"),
         out: Path = typer.Option(..., help="run directory: checkpoints go to OUT/checkpoints/"),
         policy: str = typer.Option(None, help="diffusion (default) or mlp"),
-        steps: int = typer.Option(None, help="optimiser steps in all (default 3000)"),
+        steps: int = typer.Option(None, help="optimiser steps in all (default 15000)"),
         batch_size: int = typer.Option(None, help="samples per step (default 64)"),
-        lr: float = typer.Option(None, help="peak learning rate (default 3e-4)"),
+        lr: float = typer.Option(None, help="peak learning rate (default 1e-3)"),
         seed: int = typer.Option(None, help="seed of the weights, batches and noise (default 0)"),
-        checkpoint_every: int = typer.Option(None, help="steps between checkpoints (default 500)"),
+        checkpoint_every: int = typer.Option(None, help="steps between checkpoints (default 1000)"),
         obs: str = typer.Option(None, help="comma-separated observation features (default: "
                                 "observation.state, observation.ee_pose and observation.environment_state "
                                 "if the dataset has it)"),
