@@ -124,7 +124,7 @@ def train_run(dataset: Path, run: Path, config: Any, threads: int) -> tuple[floa
     """One training run (resumed if interrupted): its seconds and samples per second."""
     from vcage.policy.train import train
 
-    summary = train(dataset, run, config, resume=True, threads=threads)
+    summary = train(dataset, run, config, resume=True, threads=threads, keep=2)  # 20 MB each
     return summary.seconds, summary.samples_per_second
 
 

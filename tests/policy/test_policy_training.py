@@ -90,6 +90,27 @@ def test_a_resumed_run_ends_with_the_weights_of_an_uninterrupted_one(dataset: Pa
         "step-00000007.pt", "step-00000014.pt", "step-00000020.pt"]
 
 
+def test_a_run_that_keeps_two_checkpoints_deletes_the_older_ones_and_still_resumes(dataset: Path,
+                                                                                   tmp_path: Path) -> None:
+    config = tiny("mlp", steps=10, checkpoint_every=2)
+    whole = train(dataset, tmp_path / "whole", config).checkpoint
+    assert len(checkpoints(tmp_path / "whole")) == 5  # every checkpoint, by default
+
+    def interrupt(step: int, total: int, loss: float) -> None:
+        if step == 7:
+            raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        train(dataset, tmp_path / "cut", config, progress=interrupt, keep=2)
+    assert [p.name for p in checkpoints(tmp_path / "cut")] == ["step-00000004.pt", "step-00000006.pt"]
+    resumed = train(dataset, tmp_path / "cut", config, resume=True, keep=2)
+    assert [p.name for p in checkpoints(tmp_path / "cut")] == ["step-00000008.pt", "step-00000010.pt"]
+    assert same_weights(whole, resumed.checkpoint)
+    with pytest.raises(ConfigError, match="keep-checkpoints"):
+        train(dataset, tmp_path / "other", config, keep=0)
+    assert not (tmp_path / "other").exists()
+
+
 def test_resume_starts_afresh_in_an_empty_directory_and_refuses_another_config(dataset: Path,
                                                                                 tmp_path: Path) -> None:
     out = tmp_path / "run"

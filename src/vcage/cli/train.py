@@ -28,6 +28,8 @@ def train_cmd(
                                 "if the dataset has it)"),
         rotations: str = typer.Option(None, help="how the policy reads quaternions: rot6d (default: "
                                       "rotation-matrix columns, continuous) or quaternion (as stored)"),
+        keep_checkpoints: int = typer.Option(None, min=1, help="keep only this many newest checkpoints "
+                                             "(default: all; each is about 20 MB at the default sizes)"),
         resume: bool = typer.Option(False, help="continue the run in OUT from its last checkpoint (only "
                                     "--steps may change)"),
         device: str = typer.Option("cpu", help="cpu, or cuda when a GPU is present"),
@@ -55,7 +57,8 @@ def train_cmd(
         bar.update(job, completed=step, description=f"training {config.policy} (loss {loss:.4f})")
 
     try:
-        summary = train(dataset, out, config, resume=resume, device=device, threads=threads, progress=update)
+        summary = train(dataset, out, config, resume=resume, device=device, threads=threads, progress=update,
+                        keep=keep_checkpoints)
     finally:
         if bar.live.is_started:
             bar.stop()

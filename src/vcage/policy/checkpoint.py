@@ -1,7 +1,8 @@
 """Checkpoint files: written atomically, found in a run directory, read back with clear errors.
 
 A run directory ``OUT`` holds ``OUT/checkpoints/step-<step>.pt``, one per checkpoint interval and
-one at the end. Each is a ``torch.save`` of plain data and tensors (read back with
+one at the end (or only the newest few, when the run keeps that many: each is about 20 MB at the
+default sizes). Each is a ``torch.save`` of plain data and tensors (read back with
 ``weights_only=True``: loading a checkpoint runs no code) written to a temporary name in the same
 directory, flushed to disk, and moved into place with ``os.replace``: a crash leaves either the
 previous checkpoints or the new one, never a torn file.
@@ -36,6 +37,18 @@ def checkpoints(out: Path) -> list[Path]:
         return []
     found = [(int(m.group(1)), p) for p in folder.iterdir() if (m := NAME.match(p.name)) and p.is_file()]
     return [p for _, p in sorted(found)]
+
+
+def prune_checkpoints(out: Path, keep: int) -> list[Path]:
+    """Delete all but the ``keep`` newest checkpoints of a run directory; the deleted paths."""
+    if keep < 1:
+        raise CheckpointError(f"a run keeps at least its latest checkpoint, got keep={keep}")
+    found = checkpoints(out)
+    old = found[:-keep]
+    for path in old:
+        with contextlib.suppress(FileNotFoundError):
+            path.unlink()
+    return old
 
 
 def latest_checkpoint(out: Path) -> Path | None:

@@ -22,7 +22,13 @@ import torch
 
 from vcage import __version__
 from vcage.errors import ConfigError
-from vcage.policy.checkpoint import checkpoint_path, latest_checkpoint, load_checkpoint, save_checkpoint
+from vcage.policy.checkpoint import (
+    checkpoint_path,
+    latest_checkpoint,
+    load_checkpoint,
+    prune_checkpoints,
+    save_checkpoint,
+)
 from vcage.policy.config import TrainConfig
 from vcage.policy.dataset import TrainingData, load_training_data
 from vcage.policy.devices import torch_device
@@ -175,14 +181,18 @@ def _resume_from(out: Path, config: TrainConfig, resume: bool) -> dict[str, Any]
 
 
 def train(dataset: str | Path, out: str | Path, config: TrainConfig, *, resume: bool = False,
-          device: str = "cpu", threads: int | None = None, progress: Progress | None = None) -> TrainSummary:
-    """Train ``config.policy`` on ``dataset``, writing checkpoints to ``out/checkpoints/``.
+          device: str = "cpu", threads: int | None = None, progress: Progress | None = None,
+          keep: int | None = None) -> TrainSummary:
+    """Train ``config.policy`` on ``dataset``, writing checkpoints to ``out/checkpoints/`` (only the
+    ``keep`` newest stay, if given: a new one is written before older ones are deleted).
 
     With ``resume``, continue from the latest checkpoint in ``out`` (a fresh start if there is
     none). A non-finite loss stops the run with :class:`TrainingDivergedError`; the checkpoints
     written before stay as they were.
     """
     out, where = Path(out), torch_device(device)
+    if keep is not None and (isinstance(keep, bool) or not isinstance(keep, int) or keep < 1):
+        raise ConfigError(f"--keep-checkpoints must be a positive integer, got {keep!r}")
     saved = _resume_from(out, config, resume)
     data = load_training_data(dataset, config)
     if saved is not None and saved["dataset"]["fingerprint"] != data.info.fingerprint:
@@ -213,6 +223,8 @@ def train(dataset: str | Path, out: str | Path, config: TrainConfig, *, resume: 
             if run.step % config.checkpoint_every == 0 or run.step == config.steps:
                 last_saved = checkpoint_path(out, run.step)
                 save_checkpoint(last_saved, run.payload())
+                if keep is not None:
+                    prune_checkpoints(out, keep)
         seconds = time.perf_counter() - began
     if last_saved is None:  # resumed a run that had already reached its steps
         last_saved = checkpoint_path(out, run.step)
