@@ -120,16 +120,16 @@ def train_config(args: argparse.Namespace, train_seed: int) -> Any:
                        checkpoint_every=max(1, min(500, args.steps)))
 
 
-def train_run(dataset: Path, run: Path, config: Any, threads: int) -> tuple[float, float]:
-    """One training run (resumed if interrupted): its seconds and samples per second."""
+def train_run(dataset: Path, run: Path, config: Any, threads: int) -> tuple[float, float, float]:
+    """One training run (resumed if interrupted): its seconds, samples per second and final loss."""
     from vcage.policy.train import train
 
     summary = train(dataset, run, config, resume=True, threads=threads, keep=2)  # 20 MB each
-    return summary.seconds, summary.samples_per_second
+    return summary.seconds, summary.samples_per_second, summary.final_loss
 
 
 def train_all(jobs: list[tuple[Path, Path, Any]], workers: int,
-              threads: int) -> dict[Path, tuple[float, float]]:
+              threads: int) -> dict[Path, tuple[float, float, float]]:
     """The training runs of ``jobs`` (dataset, run directory, config), ``workers`` at a time in
     spawned processes (training is single-threaded at these sizes: processes use the cores)."""
     if workers <= 1 or len(jobs) <= 1:
@@ -146,7 +146,7 @@ def train_all(jobs: list[tuple[Path, Path, Any]], workers: int,
 
 def train_and_evaluate(task: str, method: str, dataset: Path, env_config: dict[str, Any], scenes: list[int],
                        train_seed: int, args: argparse.Namespace, work: Path,
-                       trained: tuple[float, float] | None = None) -> dict[str, Any]:
+                       trained: tuple[float, float, float] | None = None) -> dict[str, Any]:
     from vcage.pipeline.evaluation import make_env
     from vcage.policy.evaluate import evaluate
 
@@ -154,7 +154,7 @@ def train_and_evaluate(task: str, method: str, dataset: Path, env_config: dict[s
     if path.is_file():
         return dict(json.loads(path.read_text()))
     run = run_dir(work, task, method, train_seed)
-    seconds, rate = trained or train_run(dataset, run, train_config(args, train_seed), args.threads)
+    seconds, rate, loss = trained or train_run(dataset, run, train_config(args, train_seed), args.threads)
     evaluation = evaluate(run, len(scenes), seed=0, max_steps=args.max_steps, env_config=env_config,
                           threads=args.threads, make_env=functools.partial(make_env, scenes=scenes),
                           workers=args.workers)
@@ -170,19 +170,10 @@ def train_and_evaluate(task: str, method: str, dataset: Path, env_config: dict[s
                                   "fit": None if fit is None else {"episodes": len(fit.episodes),
                                                                    "successes": fit.successes},
                                   "train_seconds": seconds, "train_samples_per_second": rate,
-                                  "final_loss": final_loss(run)}
+                                  "final_loss": loss}
     path.parent.mkdir(parents=True, exist_ok=True)
     path.write_text(json.dumps(out, indent=1))
     return out
-
-
-def final_loss(run: Path) -> float:
-    """The mean loss of the last steps of the run's latest checkpoint."""
-    from vcage.policy.checkpoint import load_checkpoint
-    from vcage.policy.train import LOSS_WINDOW
-
-    history = load_checkpoint(run)["loss_history"].tolist()[-LOSS_WINDOW:]
-    return float(np.mean(history)) if history else float("nan")
 
 
 def wilson(successes: int, n: int) -> tuple[float, float]:
