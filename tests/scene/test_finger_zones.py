@@ -160,3 +160,29 @@ def test_what_a_target_receives_finds_room_there(reach):
             inside[zones] += sum(footprint(o.type, o.scale, o.yaw, o.xy).intersects(room)
                                  for o in scene.objects if o.name != "coaster")
     assert inside[True] == 0 < inside[False]
+
+
+def test_what_rests_in_a_target_keeps_clear_of_the_room_it_receives_in(reach):
+    from vcage.errors import PlacementError
+    from vcage.scene.layout import Support
+    from vcage.scene.placement.geometry import carry_radius
+
+    need = carry_radius("block", 1.0)
+    inside = {True: 0, False: 0}
+    for zones in (True, False):
+        cfg = PlacementConfig(finger_zones=zones)
+        for seed in range(8):
+            layout = LayoutSpec(objects=(LayoutObject("tray", "tray", region=AREA, grasped=False, receives=need),
+                                         LayoutObject("fries", "block", support=Support("tray"), grasped=False)))
+            scene = place(layout, np.random.default_rng(seed), config=cfg, reach=reach).scene
+            pose = {o.name: o for o in scene.objects}
+            room = shapely.Point(pose["tray"].xy).buffer(need, 16)  # the tray's placement is centred
+            fries = pose["fries"]
+            inside[zones] += footprint(fries.type, fries.scale, fries.yaw, fries.xy).intersects(room)
+    assert inside[True] == 0 < inside[False]
+    # a basket too small for both what rests in it and the room for a bread: no scene, a typed error
+    crowded = LayoutSpec(objects=(
+        LayoutObject("basket", "basket", region=AREA, grasped=False, receives=carry_radius("bread", 1.0)),
+        LayoutObject("apple", "apple", support=Support("basket"), grasped=False)))
+    with pytest.raises(PlacementError, match="basket"):
+        place(crowded, np.random.default_rng(0), config=PlacementConfig(), reach=reach)

@@ -122,8 +122,26 @@ class ContextAwarePlacer(Placer):
         label = obj.support.label()
         if label not in self.maps:
             center, yaw, half = support_frame(obj, poses, self.objects)
-            self.maps[label] = SurfaceMap(label, rotated_rect(center, yaw, np.maximum(half, MIN_HALF)))
+            surface = SurfaceMap(label, rotated_rect(center, yaw, np.maximum(half, MIN_HALF)))
+            room = self._room_on(obj, poses)
+            if room is not None:
+                surface.forbid(f"the room kept for what {obj.support.obj!r} receives", room)
+            self.maps[label] = surface
         return self.maps[label]
+
+    def _room_on(self, obj: LayoutObject, poses: dict[str, Pose]) -> Polygon | None:
+        """The room a host keeps free on the surface ``obj`` stands on for what the robot will put
+        there (as on the table, :meth:`_zone`): what already rests in a basket stays clear of where
+        the hand sets the next object down. None if the host receives nothing there."""
+        assert obj.support.obj is not None
+        host = self.objects[obj.support.obj]
+        otype = CATALOG.get(host.type)
+        if not (self.config.finger_zones and host.receives > 0
+                and otype.placement(host.receives_at).name == otype.placement(obj.support.placement).name):
+            return None
+        place, pose = otype.placement(host.receives_at), poses[host.name]
+        center = to_world(pose.xy, pose.yaw, (place.pos[0] * host.scale, place.pos[1] * host.scale))
+        return Point(center).buffer(host.receives + self.config.finger_slack, 16)
 
     def _domain(self, obj: LayoutObject, shape: Polygon, poses: dict[str, Pose]) -> BaseGeometry:
         """Where ``obj``'s origin may go before anything else on the surface is considered."""
