@@ -24,7 +24,7 @@ if TYPE_CHECKING:
 @app.command("generate")
 @cli_errors
 def generate_cmd(
-        instruction: str = typer.Argument(..., help="e.g. 'get ready for work'"),
+        instruction: str = typer.Argument(None, help="e.g. 'get ready for work' (none with --subtasks)"),
         episodes: int = typer.Option(3, min=0, help="accepted episodes to add (with --total: the "
                                      "episodes the dataset must hold)"),
         total: bool = typer.Option(False, help="make the dataset hold --episodes episodes in all: "
@@ -62,11 +62,17 @@ def generate_cmd(
         scene: Path = typer.Option(None, help="a synthesized scene (`vcage synthesize ... --out DIR`: "
                                    "DIR or DIR/scene.json) the episodes start from; the dataset "
                                    "records it and where it came from"),
+        subtasks: Path = typer.Option(None, help="a subtask database (`vcage subtasks verify`): run a "
+                                      "chain of its verified subtasks instead of an instruction"),
+        chain: int = typer.Option(3, min=1, max=12, help="with --subtasks: subtasks in the chain"),
+        subtask_scene: str = typer.Option(None, help="with --subtasks: the scene id to chain in "
+                                          "(default: one drawn with the run seed)"),
         executor: str = typer.Option(None, help="local (this machine: processes) or ray"),
         address: str = typer.Option(None, help="with --executor ray: a running cluster's address "
                                     "(e.g. auto); default: start Ray locally")) -> None:
-    """Generate a verified dataset for INSTRUCTION; prints the funnel (also appended to
-    meta/vcage_runs.jsonl). Exit code 3 when fewer episodes were accepted than asked."""
+    """Generate a verified dataset for INSTRUCTION (or for a chain of verified subtasks with
+    --subtasks); prints the funnel (also appended to meta/vcage_runs.jsonl). Exit code 3 when fewer
+    episodes were accepted than asked."""
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
     from vcage.pipeline.generate import generate
@@ -86,9 +92,19 @@ def generate_cmd(
                                  "timeout": critic_timeout, "max_retries": critic_retries})})
     cfg = cfg.resolved()
     warn_if_oversubscribed(cfg.executor.name, cfg.executor.workers)
-    plan = make_planner(cfg.planner).plan(instruction)  # before any progress is shown
-    if scene is not None or cfg.synthesized is not None:
-        plan, cfg = on_synthesized_scene(plan, cfg, scene)
+    if subtasks is not None or cfg.chain is not None:
+        if instruction is not None or scene is not None:
+            raise ConfigError("--subtasks composes its own plan and scene: give no INSTRUCTION and "
+                              "no --scene")
+        plan, cfg = on_subtask_chain(cfg, subtasks, chain, subtask_scene)
+        instruction = plan.instruction
+    elif instruction is None:
+        raise ConfigError("give an INSTRUCTION (e.g. 'get ready for work'), or --subtasks DB to run a chain "
+                          "of verified subtasks")
+    else:
+        plan = make_planner(cfg.planner).plan(instruction)  # before any progress is shown
+        if scene is not None or cfg.synthesized is not None:
+            plan, cfg = on_synthesized_scene(plan, cfg, scene)
     bar = Progress(TextColumn("{task.description}"), BarColumn(),
                    TextColumn("{task.completed}/{task.total}"), TimeElapsedColumn(), console=console)
     job = None
@@ -173,6 +189,25 @@ def on_synthesized_scene(plan: Plan, cfg: GenerateConfig, path: Path | None) -> 
     assert synthesized is not None
     plan, synthesized = ground_plan(plan, synthesized)
     return plan, replace(cfg, synthesized=synthesized)
+
+
+def on_subtask_chain(cfg: GenerateConfig, db: Path | None, length: int,
+                     scene_id: str | None) -> tuple[Plan, GenerateConfig]:
+    """A chain of ``length`` verified subtasks of the database ``db`` drawn with the run seed (else
+    the chain ``cfg`` already records, rebuilt from its ids), and ``cfg`` recording it and its scene."""
+    from dataclasses import replace
+
+    from vcage.subtasks.chains import compose, rebuild
+    from vcage.subtasks.store import SubtaskStore
+
+    path = Path(db) if db is not None else Path(cfg.chain.db) if cfg.chain is not None else None
+    assert path is not None
+    with SubtaskStore(path, readonly=True) as store:
+        if db is None and cfg.chain is not None:
+            composed = rebuild(store, cfg.chain)
+        else:
+            composed = compose(store, length, cfg.seed, scene_id)
+    return composed.plan, replace(cfg, synthesized=composed.scene, chain=composed.provenance)
 
 
 def cores_available() -> int:

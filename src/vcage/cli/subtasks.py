@@ -1,5 +1,5 @@
-"""``vcage subtasks verify|list|show|export-sft``: candidate subtasks verified in simulation, in a SQLite
-database, and their programs as fine-tuning data."""
+"""``vcage subtasks verify|list|show|chain|export-sft``: candidate subtasks verified in simulation, in a
+SQLite database, long-horizon chains composed from them, and their programs as fine-tuning data."""
 
 from __future__ import annotations
 
@@ -89,6 +89,24 @@ def show(subtask_id: str = typer.Argument(..., help="an id or a unique prefix of
     with SubtaskStore(db, readonly=True) as store:
         record, trials = store.get(subtask_id)
     console.print_json(json.dumps({**record.to_dict(), "trial_log": [asdict(t) for t in trials]}))
+
+
+@subtasks_app.command("chain")
+@cli_errors
+def chain(db: Path = DB, length: int = typer.Option(3, min=1, max=12, help="subtasks in the chain"),
+          scene: str = typer.Option("", help="only this scene id (default: a scene drawn with the seed)"),
+          seed: int = typer.Option(0, help="seed that draws the scene and the chain")) -> None:
+    """Compose a long-horizon chain of verified subtasks and print it as a plan (what `vcage generate
+    --subtasks DB --chain LENGTH --seed SEED` runs)."""
+    from vcage.subtasks.chains import compose
+    from vcage.subtasks.store import SubtaskStore
+
+    with SubtaskStore(db, readonly=True) as store:
+        composed = compose(store, length, seed, scene or None)
+    console.print(f"scene {composed.provenance.scene_id} ({composed.scene.source})", highlight=False)
+    for r in composed.records:
+        console.print(f"  {r.id}  SR {r.successes}/{r.trials}  {r.description}", highlight=False)
+    console.print(composed.plan.summary(), highlight=False, markup=False)
 
 
 @subtasks_app.command("export-sft")

@@ -22,6 +22,7 @@ from vcage.critics.vlm import ENV_PREFIX as VLM_ENV_PREFIX
 from vcage.errors import ConfigError
 from vcage.planning import LLM_ENV_PREFIX, PlannerConfig
 from vcage.scene.instantiate import SceneConfig
+from vcage.subtasks.chains import SubtaskChain
 from vcage.synthesis.scene_file import SynthesizedScene
 
 SEED_LIMIT = 2**32  # seeds are unsigned 32-bit, as numpy's SeedSequence entropy
@@ -71,6 +72,9 @@ class GenerateConfig:
     # a synthesized scene (`vcage synthesize`) the episodes start from, with its provenance; None:
     # the plan's objects are placed afresh. Stored only when set, so runs without one are unchanged
     synthesized: SynthesizedScene | None = None
+    # the verified subtasks (`vcage subtasks verify`) the plan was composed from, in order; None: the
+    # plan came from the planner. Stored only when set
+    chain: SubtaskChain | None = None
 
     def __post_init__(self) -> None:
         seed = self.seed
@@ -110,6 +114,8 @@ class GenerateConfig:
                 "randomization": self.randomization.to_dict(), "executor": self.executor.to_dict()}
         if self.synthesized is not None:
             data["synthesized"] = self.synthesized.to_dict()
+        if self.chain is not None:
+            data["chain"] = self.chain.to_dict()
         return data
 
     def data_dict(self) -> dict[str, Any]:
@@ -127,7 +133,8 @@ class GenerateConfig:
     def from_dict(cls, data: dict[str, Any]) -> GenerateConfig:
         return from_fields(cls, data, planner=PlannerConfig, scene=SceneConfig, critic=CriticConfig,
                            render=RenderConfig, sim=SimConfig, randomization=Randomization,
-                           executor=ExecutorConfig, synthesized=SynthesizedScene)
+                           executor=ExecutorConfig, synthesized=SynthesizedScene,
+                           chain=SubtaskChain)
 
     def episode_seed(self, episode: int, attempt: int) -> int:
         """The seed of an attempt: derived from the run seed, the episode and the attempt index."""
