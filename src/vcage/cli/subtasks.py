@@ -30,10 +30,14 @@ def verify(scenes: list[str] = typer.Argument(..., help="task:<name>[@seed], a t
                                     "(run in the sandbox) instead of the template"),
            only: str = typer.Option("", help="verify only candidates whose template is this "
                                     "(put_on, put_in, press)"),
+           propose: int = typer.Option(0, min=0, help="also ask the model of VCAGE_LLM_* to propose up to "
+                                       "this many subtasks of its own per scene"),
            busy_timeout: float = typer.Option(30.0, help="seconds to wait for another writer")) -> None:
     """Enumerate each scene's candidate subtasks, run each TRIALS times, store the verdicts."""
     from vcage.errors import ConfigError
     from vcage.subtasks.candidates import candidates
+    from vcage.subtasks.codegen import ProgramWriter
+    from vcage.subtasks.proposals import SubtaskProposer
     from vcage.subtasks.scenes import resolve
     from vcage.subtasks.store import SubtaskStore
     from vcage.subtasks.trial import TrialConfig
@@ -44,12 +48,23 @@ def verify(scenes: list[str] = typer.Argument(..., help="task:<name>[@seed], a t
     cfg = TrialConfig(trials=trials)
     resolved = [resolve(ref) for ref in scenes]  # every scene is checked before anything is written
     judge = _critic(critic)
-    writer = _writer() if llm else None
+    backend = _backend() if llm or propose else None
+    writer = ProgramWriter(backend) if llm and backend is not None else None
+    proposer = SubtaskProposer(backend, propose) if propose and backend is not None else None
     total = Funnel()
     db.parent.mkdir(parents=True, exist_ok=True)
     with SubtaskStore(db, busy_timeout=busy_timeout) as store:
         for scene, spec in resolved:
-            cands = [c for c in candidates(scene.id, spec) if not only or c.template == only]
+            known = candidates(scene.id, spec)
+            cands = [c for c in known if not only or c.template == only]
+            if proposer is not None:
+                extra, counts = proposer.propose(scene.id, spec, known)
+                console.print(f"scene {scene.id}: the model proposed {counts.proposed} subtask(s) in "
+                              f"{counts.replies} replies: {counts.valid} kept, {counts.duplicates} repeating "
+                              f"known ones, {counts.invalid} still invalid", highlight=False)
+                for problem in counts.problems:
+                    console.print(f"  still invalid: {problem}", highlight=False, markup=False)
+                cands += extra
             if writer is not None:
                 cands = [writer.write(c, spec) for c in cands]
             console.print(f"scene {scene.id} ({scene.source}): {len(cands)} candidate(s)")
@@ -142,8 +157,7 @@ def _critic(name: str):  # type: ignore[no-untyped-def]
     return critic
 
 
-def _writer():  # type: ignore[no-untyped-def]
+def _backend():  # type: ignore[no-untyped-def]
     from vcage.backends import BackendConfig, connect
-    from vcage.subtasks.codegen import ProgramWriter
 
-    return ProgramWriter(connect(BackendConfig.from_env("VCAGE_LLM")))  # no model set: ConfigError
+    return connect(BackendConfig.from_env("VCAGE_LLM"))  # no model set: ConfigError

@@ -31,6 +31,11 @@ def skill_library() -> str:
     return "\n".join(f"- {s.name}({s.signature()}): {s.doc}" for s in PLAN_SKILLS.values())
 
 
+def predicate_lines() -> str:
+    return "\n".join(f"- {p.name} ({p.arity[0]}..{p.arity[1]} objects): {p.meaning}"
+                     for p in PREDICATES.values())
+
+
 def catalog_lines() -> str:
     lines = []
     for t in CATALOG.values():
@@ -43,8 +48,6 @@ def catalog_lines() -> str:
 
 def system_prompt(max_subtasks: int = MAX_SUBTASKS) -> str:
     example = GOALS[0].plan(GOALS[0].phrasings[0]).model_dump(mode="json", exclude_none=True)
-    preds = "\n".join(f"- {p.name} ({p.arity[0]}..{p.arity[1]} objects): {p.meaning}"
-                       for p in PREDICATES.values())
     return (
         "You plan tabletop manipulation for a Franka Panda arm. Turn the user's instruction into a "
         "JSON plan: the objects the scene needs (catalog types only, each with a unique name; `on` "
@@ -53,7 +56,7 @@ def system_prompt(max_subtasks: int = MAX_SUBTASKS) -> str:
         "is rejected, so one subtask per requested step, no extra ones). Each subtask calls one skill "
         "with arguments that name plan objects, says in one sentence what must be visibly true "
         "afterwards, and lists the predicates that define its success.\n\n"
-        f"Skills:\n{skill_library()}\n\nPredicates:\n{preds}\n\n"
+        f"Skills:\n{skill_library()}\n\nPredicates:\n{predicate_lines()}\n\n"
         f"Catalog:\n{catalog_lines()}\n\n"
         f"JSON schema of the reply:\n{json.dumps(plan_json_schema(), separators=(',', ':'))}\n\n"
         f"Example for '{example['instruction']}':\n{json.dumps(example, separators=(',', ':'))}\n\n"
