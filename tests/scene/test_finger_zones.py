@@ -169,11 +169,11 @@ def test_what_rests_in_a_target_keeps_clear_of_the_room_it_receives_in(reach):
 
     need = carry_radius("block", 1.0)
     inside = {True: 0, False: 0}
+    layout = LayoutSpec(objects=(LayoutObject("tray", "tray", region=AREA, grasped=False, receives=need),
+                                 LayoutObject("fries", "block", support=Support("tray"), grasped=False)))
     for zones in (True, False):
         cfg = PlacementConfig(finger_zones=zones)
         for seed in range(8):
-            layout = LayoutSpec(objects=(LayoutObject("tray", "tray", region=AREA, grasped=False, receives=need),
-                                         LayoutObject("fries", "block", support=Support("tray"), grasped=False)))
             scene = place(layout, np.random.default_rng(seed), config=cfg, reach=reach).scene
             pose = {o.name: o for o in scene.objects}
             room = shapely.Point(pose["tray"].xy).buffer(need, 16)  # the tray's placement is centred

@@ -34,6 +34,17 @@ def test_candidates_pair_graspable_objects_with_surfaces_they_fit_and_press_func
                                               "args": {"obj": "cube", "target": "dish"}}]
 
 
+def test_a_bowl_nests_in_a_larger_bowl_and_same_type_containers_otherwise_do_not() -> None:
+    bowls = SceneSpec(objects=(ObjectSpec("small", "bowl", (0.45, -0.15), scale=0.85),
+                               ObjectSpec("large", "bowl", (0.6, 0.1)),
+                               ObjectSpec("twin", "bowl", (0.6, -0.2)),
+                               ObjectSpec("cup_a", "cup", (0.45, 0.2), scale=0.7),
+                               ObjectSpec("cup_b", "cup", (0.4, 0.0))))
+    nested = {tuple(c.args.values()) for c in candidates("s", bowls) if c.template == "put_in"
+              and bowls.object(c.args["obj"]).type == bowls.object(c.args["target"]).type}
+    assert nested == {("small", "large"), ("small", "twin")}  # not large in twin: the same size
+
+
 def test_identity_and_trial_seeds_are_deterministic() -> None:
     a, b = candidates("s", SCENE), candidates("s", SCENE)
     assert [c.id for c in a] == [c.id for c in b] and len({c.id for c in a}) == len(a)

@@ -20,7 +20,8 @@ from vcage.subtasks.proposals import SubtaskProposer
 from vcage.subtasks.store import SubtaskStore
 
 SCENE = SceneSpec(objects=(ObjectSpec("cube", "block", (0.45, -0.12), color="red"),
-                           ObjectSpec("dish", "plate", (0.55, 0.12)), ObjectSpec("bell", "bell", (0.6, -0.1))))
+                           ObjectSpec("dish", "plate", (0.55, 0.12)),
+                           ObjectSpec("bell", "bell", (0.6, -0.1))))
 RUN = CliRunner()
 
 
@@ -73,7 +74,8 @@ def test_invalid_proposals_are_sent_back_until_fixed_or_given_up() -> None:
         second, third = server.requests[1]["messages"], server.requests[2]["messages"]
     assert "not valid JSON" in second[-1]["content"]
     assert "subtask 0:" in third[-1]["content"] and "off the table" in third[-1]["content"]
-    assert "subtask 1:" in third[-1]["content"] and "'lamp' is not an object of the scene" in third[-1]["content"]
+    assert "subtask 1:" in third[-1]["content"]
+    assert "'lamp' is not an object of the scene" in third[-1]["content"]
     assert [c.description for c in got] == ["put the cube left of the dish"]  # the press repeats a known one
     assert counts.invalid == 1 and "no predicate says anything about 'bell'" in counts.problems[0]
     assert counts.duplicates == 1 and counts.replies == 3
@@ -101,7 +103,8 @@ def test_verify_proposes_checks_and_stores_the_models_subtasks(tmp_path: Path,
         done = RUN.invoke(app, ["subtasks", "verify", str(tmp_path), "--db", db, "--propose", "3", "--only",
                                 "press", "--trials", "1", "--critic", "oracle"])
     assert done.exit_code == 0, done.output
-    assert "proposed 2 subtask(s) in 1 replies: 1 kept, 1 repeating known ones" in " ".join(done.output.split())
+    flat = " ".join(done.output.split())
+    assert "proposed 2 subtask(s) in 1 replies: 1 kept, 1 repeating known ones" in flat
     with SubtaskStore(db, readonly=True) as store:
         rows = {r.description: r for r in store.subtasks()}
     assert set(rows) == {"press the bell (button)", "put the cube left of the dish"}

@@ -6,7 +6,8 @@ press or turn). Each becomes a candidate subtask with its success predicates in 
 
 - ``put_on`` / ``put_in``: ``pick_and_place(obj, target)`` with ``on``/``inside(obj, target)`` and
   ``released(obj)``, for a target's first placement (the one the predicates check), when the object
-  could fit: through the container's opening (``in``) or onto the surface (``on``: no wider than the
+  could fit: through the container's opening (``in``; an object of the container's own type only
+  when the type nests, a bowl in a larger bowl) or onto the surface (``on``: no wider than the
   target is long, and at most :data:`ON_AREA` times its footprint);
 - ``press``: ``press(obj, point)`` with ``pressed(obj)`` and ``upright(obj)``, per point with a joint.
 
@@ -23,6 +24,7 @@ from dataclasses import dataclass, field, replace
 from typing import Any
 
 from vcage.assets.catalog import CATALOG, ObjectType
+from vcage.assets.objects.containers import NEST_RATIO, NESTING
 from vcage.planning.schema import Predicate, Subtask
 from vcage.scene.spec import ObjectSpec, SceneSpec
 from vcage.subtasks.records import LLM, TEMPLATE
@@ -92,8 +94,10 @@ def _words(obj: ObjectSpec) -> str:
 def _fits(a: ObjectSpec, ta: ObjectType, b: ObjectSpec, tb: ObjectType, kind: str) -> bool:
     ax = sorted((ta.size[0] * a.scale, ta.size[1] * a.scale))
     bx = sorted((tb.size[0] * b.scale, tb.size[1] * b.scale))
+    if kind == "in" and a.type == b.type:  # nesting: only flared containers, the inner one smaller
+        return a.type in NESTING and a.scale <= NEST_RATIO * b.scale + 1e-9
     if kind == "in":  # through the opening, narrow side to narrow side
-        return ax[0] <= bx[0] + FIT_SLACK and ax[1] <= bx[1] + FIT_SLACK and a.type != b.type
+        return ax[0] <= bx[0] + FIT_SLACK and ax[1] <= bx[1] + FIT_SLACK
     # onto the surface: no wider than it is long, and not much larger (a pot does not go on a plate)
     return ax[0] <= bx[1] + FIT_SLACK and ax[0] * ax[1] <= ON_AREA * bx[0] * bx[1]
 

@@ -104,6 +104,10 @@ CATALOG.add_type(ObjectType(
 # --- bowl (flared, nests) -----------------------------------------------------------------------
 BOWL_R0, BOWL_R1, BOWL_H, BOWL_T, BOWL_FLOOR = 0.036, 0.07, 0.055, 0.004, 0.004
 BOWL_FRICTION = 0.15
+# Types whose flared walls let one go inside another of the type, and how much smaller (scale) the
+# inner one must be
+NESTING = frozenset({"bowl"})
+NEST_RATIO = 0.92
 _BOWL_TILT = math.atan2(BOWL_R1 - BOWL_R0, BOWL_H - BOWL_FLOOR)
 _BOWL_OUT = BOWL_R1 + BOWL_T * math.cos(_BOWL_TILT)  # outer radius at the rim
 

@@ -6,12 +6,11 @@ from dataclasses import replace
 
 import numpy as np
 
+from vcage.assets.objects.containers import NEST_RATIO
 from vcage.config import Randomization
 from vcage.scene.layout import LayoutSpec
 from vcage.tasks.base import TASKS, Item
 from vcage.tasks.templates import PlaceTask
-
-NEST_RATIO = 0.92  # the inner bowl is at most this fraction of the outer bowl's scale
 
 
 @TASKS.register("stack_bowls_two")
