@@ -100,3 +100,49 @@ def test_bad_scenes_are_typed_errors(scene_dir: Path, tmp_path: Path) -> None:
                                   "--scene", str(path)])
         assert result.exit_code == 2 and message in result.output, result.output
         assert not (tmp_path / "x").exists()  # nothing written before the refusal
+
+
+def test_every_attempt_can_start_from_a_scene_synthesized_for_it(tmp_path: Path) -> None:
+    from vcage.pipeline.episode import attempt
+    from vcage.pipeline.generate import generate
+    from vcage.pipeline.plan_layout import episode_scene
+    from vcage.planning.schema import Plan, PlanObject
+    from vcage.synthesis.scene_file import SynthesisRequest
+
+    out = tmp_path / "cli"
+    made = RUN.invoke(app, ["generate", INSTRUCTION, "--synthesize", PROMPT, "--episodes", "1",
+                            "--out", str(out), "--size", "64", "--cameras", "front", "--clutter", "1"])
+    assert made.exit_code == 0, made.output
+    stored = DatasetReader(out).config or {}
+    cfg = GenerateConfig.from_dict(stored["generate"])
+    assert cfg.synthesis == SynthesisRequest(PROMPT) and cfg.synthesized is None
+    plan = Plan.model_validate(stored["plan"])
+    assert {o.type for o in plan.objects} == {"mouse", "mouse_pad"}
+    # without randomisation each episode's objects stand exactly where its own scene put them
+    cfg = replace(cfg, randomization=Randomization(enabled=False))
+    root = tmp_path / "api"
+    generate(INSTRUCTION, 2, root, cfg, plan=plan)
+    reader = DatasetReader(root)
+    starts = []
+    for i in range(2):
+        extras = reader.extras(i)
+        own = episode_scene(plan, cfg.synthesis, extras["seed"])
+        placed = {o["name"]: tuple(o["xy"]) for o in extras["scene"]["objects"]}
+        assert all(placed[o.name] == pytest.approx((o.x, o.y)) for o in own.objects)
+        starts.append(placed)
+    assert starts[0] != starts[1]  # a new scene per episode, not one scene jittered
+    # the evaluation environment of such a dataset synthesizes its scenes the same way
+    from vcage.pipeline.evaluation import make_env
+
+    env = make_env(reader.config or {}, seed=3)
+    env.reset()
+    assert env.world is not None and env.scene_seed is not None
+    own = episode_scene(plan, cfg.synthesis, env.scene_seed)
+    for o in own.objects:
+        assert env.world.object_pos(o.name)[:2] == pytest.approx((o.x, o.y), abs=0.01)
+    env.close()
+    # a plan the synthesized scene cannot hold: the attempt is refused, naming synthesis
+    extra = plan.model_copy(update={"objects": (*plan.objects, PlanObject(name="cup", type="cup"))})
+    refused = attempt(extra, 7, cfg, None)
+    assert refused.stage == "placement" and refused.reason.startswith("synthesis: ")
+    assert "cup" in refused.reason

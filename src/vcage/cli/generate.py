@@ -62,6 +62,9 @@ def generate_cmd(
         scene: Path = typer.Option(None, help="a synthesized scene (`vcage synthesize ... --out DIR`: "
                                    "DIR or DIR/scene.json) the episodes start from; the dataset "
                                    "records it and where it came from"),
+        synthesize: str = typer.Option(None, help="a prompt (e.g. 'organize the breakfast table') to "
+                                       "synthesize a new scene from for every attempt, offline, seeded by "
+                                       "the attempt; the plan is grounded on its objects"),
         subtasks: Path = typer.Option(None, help="a subtask database (`vcage subtasks verify`): run a "
                                       "chain of its verified subtasks instead of an instruction"),
         chain: int = typer.Option(3, min=1, max=12, help="with --subtasks: subtasks in the chain"),
@@ -93,9 +96,9 @@ def generate_cmd(
     cfg = cfg.resolved()
     warn_if_oversubscribed(cfg.executor.name, cfg.executor.workers)
     if subtasks is not None or cfg.chain is not None:
-        if instruction is not None or scene is not None:
-            raise ConfigError("--subtasks composes its own plan and scene: give no INSTRUCTION and "
-                              "no --scene")
+        if instruction is not None or scene is not None or synthesize is not None:
+            raise ConfigError("--subtasks composes its own plan and scene: give no INSTRUCTION, no "
+                              "--scene and no --synthesize")
         plan, cfg = on_subtask_chain(cfg, subtasks, chain, subtask_scene)
         instruction = plan.instruction
     elif instruction is None:
@@ -103,7 +106,11 @@ def generate_cmd(
                           "of verified subtasks")
     else:
         plan = make_planner(cfg.planner).plan(instruction)  # before any progress is shown
-        if scene is not None or cfg.synthesized is not None:
+        if synthesize is not None or cfg.synthesis is not None:
+            if scene is not None:
+                raise ConfigError("--synthesize makes a new scene for every attempt: give no --scene")
+            plan, cfg = on_scene_per_attempt(plan, cfg, synthesize)
+        elif scene is not None or cfg.synthesized is not None:
             plan, cfg = on_synthesized_scene(plan, cfg, scene)
     bar = Progress(TextColumn("{task.description}"), BarColumn(),
                    TextColumn("{task.completed}/{task.total}"), TimeElapsedColumn(), console=console)
@@ -189,6 +196,23 @@ def on_synthesized_scene(plan: Plan, cfg: GenerateConfig, path: Path | None) -> 
     assert synthesized is not None
     plan, synthesized = ground_plan(plan, synthesized)
     return plan, replace(cfg, synthesized=synthesized)
+
+
+def on_scene_per_attempt(plan: Plan, cfg: GenerateConfig, prompt: str | None) -> tuple[Plan, GenerateConfig]:
+    """The plan grounded on the scene synthesized from ``prompt`` (else from the prompt ``cfg``
+    already holds) for the run seed, and ``cfg`` asking for a new scene for every attempt."""
+    from dataclasses import replace
+
+    from vcage.synthesis.driver import SynthesisConfig, synthesized_scene
+    from vcage.synthesis.scene_file import SynthesisRequest, ground_plan
+
+    request = SynthesisRequest(prompt) if prompt is not None else cfg.synthesis
+    assert request is not None
+    options = SynthesisConfig(seed=cfg.seed, attempts=request.attempts, perturbation=request.perturbation,
+                              lam=request.lam)
+    first = synthesized_scene(request.prompt, options)
+    plan, _ = ground_plan(plan, first)
+    return plan, replace(cfg, synthesis=request, synthesized=None)
 
 
 def on_subtask_chain(cfg: GenerateConfig, db: Path | None, length: int,

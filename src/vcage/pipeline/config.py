@@ -23,7 +23,7 @@ from vcage.errors import ConfigError
 from vcage.planning import LLM_ENV_PREFIX, PlannerConfig
 from vcage.scene.instantiate import SceneConfig
 from vcage.subtasks.chains import SubtaskChain
-from vcage.synthesis.scene_file import SynthesizedScene
+from vcage.synthesis.scene_file import SynthesisRequest, SynthesizedScene
 
 SEED_LIMIT = 2**32  # seeds are unsigned 32-bit, as numpy's SeedSequence entropy
 # how a backend is reached, not what it answers: not compared when appending to a dataset
@@ -75,6 +75,9 @@ class GenerateConfig:
     # the verified subtasks (`vcage subtasks verify`) the plan was composed from, in order; None: the
     # plan came from the planner. Stored only when set
     chain: SubtaskChain | None = None
+    # a prompt to synthesize a new scene from for every attempt (seeded by the attempt's seed); None:
+    # the plan's layout (or ``synthesized``). Stored only when set
+    synthesis: SynthesisRequest | None = None
 
     def __post_init__(self) -> None:
         seed = self.seed
@@ -116,6 +119,8 @@ class GenerateConfig:
             data["synthesized"] = self.synthesized.to_dict()
         if self.chain is not None:
             data["chain"] = self.chain.to_dict()
+        if self.synthesis is not None:
+            data["synthesis"] = self.synthesis.to_dict()
         return data
 
     def data_dict(self) -> dict[str, Any]:
@@ -134,7 +139,7 @@ class GenerateConfig:
         return from_fields(cls, data, planner=PlannerConfig, scene=SceneConfig, critic=CriticConfig,
                            render=RenderConfig, sim=SimConfig, randomization=Randomization,
                            executor=ExecutorConfig, synthesized=SynthesizedScene,
-                           chain=SubtaskChain)
+                           chain=SubtaskChain, synthesis=SynthesisRequest)
 
     def episode_seed(self, episode: int, attempt: int) -> int:
         """The seed of an attempt: derived from the run seed, the episode and the attempt index."""

@@ -13,10 +13,10 @@ from dataclasses import dataclass, field, fields
 import numpy as np
 
 from vcage.critics.base import Critic
-from vcage.errors import PlacementError, SimulationError
+from vcage.errors import PlacementError, SimulationError, VcageError
 from vcage.pipeline.config import GenerateConfig
 from vcage.pipeline.critic_views import sheet_png
-from vcage.pipeline.plan_layout import plan_layout
+from vcage.pipeline.plan_layout import episode_scene, plan_layout
 from vcage.pipeline.rollout import Rollout, run_plan
 from vcage.pipeline.stage import Stage
 from vcage.pipeline.verifier import Verifier
@@ -108,7 +108,12 @@ def _attempt(plan: Plan, seed: int, cfg: GenerateConfig, critic: Critic | None, 
     clock = time.perf_counter
     t0 = clock()
     rng = np.random.default_rng(seed)
-    layout = plan_layout(plan, rng, cfg.randomization, cfg.scene.clutter, scene=cfg.synthesized)
+    try:
+        scene = cfg.synthesized if cfg.synthesis is None else episode_scene(plan, cfg.synthesis, seed)
+    except VcageError as exc:  # no scene came out of synthesis, or not the plan's
+        timing.placement += clock() - t0
+        return Attempt(seed, Stage.PLACEMENT, f"synthesis: {exc}")
+    layout = plan_layout(plan, rng, cfg.randomization, cfg.scene.clutter, scene=scene)
     instantiator = Instantiator(cfg.scene, cfg.sim, reach_map())
     try:
         spec, stats = instantiator.place(layout, rng)

@@ -36,13 +36,14 @@ from gymnasium.error import ResetNeeded
 from vcage.errors import ConfigError, PlacementError, SceneError, SimulationError
 from vcage.pipeline.config import GenerateConfig
 from vcage.pipeline.features import EE_POSE, ENVIRONMENT, STATE, dataset_features, observe
-from vcage.pipeline.plan_layout import plan_layout
+from vcage.pipeline.plan_layout import episode_scene, plan_layout
 from vcage.planning.schema import Plan
 from vcage.scene.instantiate import Instantiator
 from vcage.sim.render import Renderer
 from vcage.sim.robot import GRIPPER_OPEN
 from vcage.sim.world import World
 from vcage.skills.reachability import reach_map
+from vcage.synthesis.errors import SynthesisError
 from vcage.tasks.oracle import Oracle
 from vcage.tasks.success import HOLD_STEPS
 
@@ -121,8 +122,9 @@ class GoalEnv(gym.Env[dict[str, np.ndarray], np.ndarray]):
     def _scene(self, seed: int) -> World:
         """The settled world of a scene seed; PlacementError/SceneError/SimulationError if there is none."""
         rng = np.random.default_rng(seed)
-        layout = plan_layout(self.plan, rng, self.cfg.randomization, self.cfg.scene.clutter,
-                             scene=self.cfg.synthesized)
+        synthesis = self.cfg.synthesis
+        scene = self.cfg.synthesized if synthesis is None else episode_scene(self.plan, synthesis, seed)
+        layout = plan_layout(self.plan, rng, self.cfg.randomization, self.cfg.scene.clutter, scene=scene)
         spec, stats = self._instantiator.place(layout, rng)
         instance = self._instantiator.realize(spec, stats)
         if not instance.valid:
@@ -154,7 +156,7 @@ class GoalEnv(gym.Env[dict[str, np.ndarray], np.ndarray]):
             scene_seed = eval_seed(base, episode, j)
             try:
                 return self._scene(scene_seed), scene_seed
-            except (PlacementError, SceneError, SimulationError) as exc:
+            except (PlacementError, SceneError, SimulationError, SynthesisError) as exc:
                 reasons.append(str(exc).split(";")[0][:120])
         raise SceneError(f"no valid evaluation scene for episode {episode} in {self.cfg.max_attempts} tries "
                          f"({'; '.join(reasons[:3])}); raise max_attempts or reduce the clutter")

@@ -14,6 +14,7 @@ import numpy as np
 
 from vcage.assets.catalog import CATALOG
 from vcage.config import Randomization
+from vcage.errors import SceneError
 from vcage.planning.schema import Plan, PlanObject
 from vcage.scene.layout import (
     Distractors,
@@ -26,7 +27,7 @@ from vcage.scene.layout import (
 )
 from vcage.scene.placement.geometry import carry_radius
 from vcage.scene.randomize import environment, object_look
-from vcage.synthesis.scene_file import PlacedObject, SynthesizedScene
+from vcage.synthesis.scene_file import PlacedObject, SynthesisRequest, SynthesizedScene, ground_plan
 
 # x 0.45..0.70, y -0.3..0.3 (metres): reachable for every skill, and clear of the arm's home pose
 # in the top view, so that the critic sees the objects after each subtask
@@ -65,6 +66,23 @@ def plan_layout(plan: Plan, rng: np.random.Generator, rand: Randomization, clutt
         for i, st in enumerate(plan.subtasks) if st.args.get("xy") is not None)
     return LayoutSpec(objects=tuple(objects), relations=relations, reserved=reserved,
                       distractors=Distractors(clutter), **environment(rng, rand))
+
+
+def episode_scene(plan: Plan, request: SynthesisRequest, seed: int) -> SynthesizedScene:
+    """A scene synthesized afresh from ``request`` for the attempt of ``seed``, its objects named as
+    ``plan``'s (grounded as :func:`~vcage.synthesis.scene_file.ground_plan` does). Raises
+    :class:`~vcage.errors.SceneError` when the scene is not the one the plan was grounded on (other
+    objects, colours or supports), and the synthesis' own errors when no scene came out."""
+    from vcage.synthesis.driver import SynthesisConfig, synthesized_scene
+
+    cfg = SynthesisConfig(seed=seed, attempts=request.attempts, perturbation=request.perturbation,
+                          lam=request.lam)
+    grounded, scene = ground_plan(plan, synthesized_scene(request.prompt, cfg))
+    if grounded.objects != plan.objects:
+        got = ", ".join(f"{o.name} ({o.type})" for o in grounded.objects)
+        raise SceneError(f"the scene synthesized from {request.prompt!r} for seed {seed} holds {got}, not "
+                         "the plan's objects; synthesis must give the same objects for every seed")
+    return scene
 
 
 def _room_needed(plan: Plan, scales: dict[str, float]) -> dict[str, tuple[float, str | None]]:

@@ -39,7 +39,7 @@ from vcage.synthesis.refine import RefineConfig, refine
 from vcage.synthesis.relations_check import Held, relations_held
 from vcage.synthesis.retrieval import Retrieval, retriever
 from vcage.synthesis.scene_file import FILE as SCENE_FILE
-from vcage.synthesis.scene_file import settled_scene, yaw_of
+from vcage.synthesis.scene_file import SynthesizedScene, settled_scene, yaw_of
 from vcage.synthesis.settle import rests_on, scene_spec, settle
 from vcage.synthesis.text import content
 from vcage.synthesis.views import render_top
@@ -73,6 +73,19 @@ class DirectorySink:
 class NullSink:
     def json(self, name: str, data: Any) -> None:
         pass
+
+    def png(self, name: str, image: np.ndarray) -> None:
+        pass
+
+
+class MemorySink:
+    """Keeps the JSON artefacts in memory (``data`` by name) and drops the images."""
+
+    def __init__(self) -> None:
+        self.data: dict[str, Any] = {}
+
+    def json(self, name: str, data: Any) -> None:
+        self.data[name] = json.loads(json.dumps(data, default=str))
 
     def png(self, name: str, image: np.ndarray) -> None:
         pass
@@ -158,6 +171,14 @@ def synthesize(prompt: str, cfg: SynthesisConfig | None = None, sink: Sink | Non
             last = exc
     raise SynthesisError(f"no valid scene for {text!r} after {cfg.attempts} attempts; last: {last}. "
                          "Try another seed, more attempts, or a prompt with fewer objects")
+
+
+def synthesized_scene(prompt: str, cfg: SynthesisConfig) -> SynthesizedScene:
+    """The settled scene one run for ``prompt`` makes (offline: retrieval, description and the
+    compositor), without writing its artefacts: what a generation attempt starts from."""
+    sink = MemorySink()
+    synthesize(prompt, cfg, sink)
+    return SynthesizedScene.from_dict(sink.data[SCENE_FILE])
 
 
 Record = Callable[..., None]

@@ -87,6 +87,34 @@ class SynthesizedScene:
             raise ConfigError(f"the synthesized scene is malformed: {exc}") from None
 
 
+@dataclass(frozen=True)
+class SynthesisRequest:
+    """A scene to synthesize afresh for every episode attempt (seeded by the attempt): the prompt and
+    the synthesis options that change the scene (see :class:`~vcage.synthesis.driver.SynthesisConfig`)."""
+
+    prompt: str
+    attempts: int = 3
+    perturbation: str = "none"
+    lam: float = 1.0
+
+    def __post_init__(self) -> None:
+        if not self.prompt.strip():
+            raise ConfigError("the synthesis prompt is empty; say what the scene holds, e.g. 'organize the "
+                              "breakfast table'")
+        if isinstance(self.attempts, bool) or not isinstance(self.attempts, int) or self.attempts < 1:
+            raise ConfigError(f"synthesis attempts must be an integer >= 1, got {self.attempts!r}")
+
+    def to_dict(self) -> dict[str, Any]:
+        return asdict(self)
+
+    @classmethod
+    def from_dict(cls, data: dict[str, Any]) -> SynthesisRequest:
+        try:
+            return cls(**data)
+        except TypeError as exc:
+            raise ConfigError(f"the synthesis request is malformed: {exc}") from None
+
+
 def load_scene(path: Path | str) -> SynthesizedScene:
     """The scene in ``path`` (a synthesis directory or its ``scene.json``), with its provenance."""
     path = Path(path)
