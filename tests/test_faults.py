@@ -39,7 +39,7 @@ def _rollout(fault: FaultConfig | None, skill: str = "pick_and_place", **args: o
 def test_every_fault_perturbs_registered_skills_and_every_plan_skill_has_faults() -> None:
     for spec in FAULTS.values():
         assert spec.doc and all(s in SKILLS for s in spec.skills), spec.name
-    for skill in ("pick_and_place", "press", "grasp"):
+    for skill in ("pick_and_place", "press", "grasp", "turn_and_place", "move_line", "shake"):
         assert faults_for(skill)
 
 
@@ -87,3 +87,26 @@ def test_wrong_object_moves_another_object_and_after_faults_need_a_next_call() -
     injector = FaultInjector(FaultConfig("knock_over"))
     Skills(world, fault=injector).do("press", obj="bell")
     assert not injector.applied  # it acts on the result: planned before the next call
+
+
+NEW_SKILL_FAULTS = [("rotate_qrcode", "turn_short"), ("beat_block_hammer", "stop_short"),
+                    ("shake_bottle", "shake_weak")]
+
+
+@pytest.mark.parametrize(("task", "fault"), NEW_SKILL_FAULTS)
+def test_the_new_skills_faults_run_cleanly_and_fail_the_task_the_expert_solves(task: str, fault: str) -> None:
+    from vcage.config import Randomization
+    from vcage.tasks.runner import prepare
+    from vcage.tasks.success import held
+
+    outcome = {}
+    for name in (None, fault):
+        t, world, _ = prepare(task, 0, Randomization())
+        injector = FaultInjector(FaultConfig(name, seed=1)) if name else None
+        skills = Skills(world, fault=injector)
+        skills.player.hooks.append(t.on_step)
+        t.expert(skills)  # a silent failure: nothing raises
+        holds, _ = held(skills, lambda t=t, skills=skills: t.evaluate(skills.world), t.hold_steps)
+        outcome[name] = holds["success"]
+        assert injector is None or injector.applied
+    assert outcome == {None: True, fault: False}

@@ -2,8 +2,9 @@
 
 A critic exists to catch failures that raise nothing: a release too high or too late, a place off
 target or on an edge, the wrong object moved, a press too light or beside the button, a neighbour
-knocked over. Each fault here is a named, seeded perturbation of one skill call, registered in
-``FAULTS``; a :class:`FaultInjector` built from a frozen :class:`FaultConfig` is given to
+knocked over, a turn short of its angle, a stroke that stops short, a shake too weak. Each fault
+here is a named, seeded perturbation of one skill call, registered in ``FAULTS``; a
+:class:`FaultInjector` built from a frozen :class:`FaultConfig` is given to
 :class:`~vcage.skills.base.Skills` (``Skills(world, fault=FaultInjector(cfg))``) and replaces the
 plan of the chosen call (or, for faults that act on the result, adds to the next call's plan).
 
@@ -37,7 +38,7 @@ from vcage.skills.base import (
     Skills,
 )
 from vcage.skills.motion import MotionPlan, Waypoint
-from vcage.skills.primitives import lift, placement_target, press, push
+from vcage.skills.primitives import lift, move_line, placement_target, press, push, shake, turn_and_place
 
 Args = Mapping[str, Any]
 Perturb = Callable[[Skills, str, Args, np.random.Generator], MotionPlan | None]
@@ -303,6 +304,27 @@ def _press_miss(s: Skills, skill: str, args: Args, rng: np.random.Generator) -> 
     wps[-1] = Waypoint(wps[-1].q, CLOSED, wps[-1].duration, hold=0.3, label="press")
     wps += s.line(wps[-1].q, contact + [0.0, 0.0, 0.06], yaw, CLOSED, SLOW_SPEED, "release")
     return MotionPlan("press", tuple(wps))
+
+
+# -- turn_and_place, move_line, shake --------------------------------------------------------------
+
+@_fault("turn_short", ("turn_and_place",), "put the object down turned only 30-60% of the angle asked")
+def _turn_short(s: Skills, skill: str, args: Args, rng: np.random.Generator) -> MotionPlan:
+    return turn_and_place(s, **{**args, "turn": float(args["turn"]) * rng.uniform(0.3, 0.6)})
+
+
+@_fault("stop_short", ("move_line",), "stop 40-70% of the way along the line (a strike, pull or slide "
+        "that never arrives)")
+def _stop_short(s: Skills, skill: str, args: Args, rng: np.random.Generator) -> MotionPlan:
+    start, _ = s.tcp()
+    goal = np.asarray(args["pos"], float)
+    return move_line(s, **{**args, "pos": start + rng.uniform(0.4, 0.7) * (goal - start)})
+
+
+@_fault("shake_weak", ("shake",), "shake once, at 20-40% of the amplitude asked")
+def _shake_weak(s: Skills, skill: str, args: Args, rng: np.random.Generator) -> MotionPlan:
+    amplitude = float(args.get("amplitude", 0.04)) * rng.uniform(0.2, 0.4)
+    return shake(s, **{**args, "amplitude": amplitude, "cycles": 1})
 
 
 # -- both -------------------------------------------------------------------------------------------
