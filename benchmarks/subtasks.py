@@ -139,7 +139,8 @@ def main() -> None:
     parser.add_argument("--silent", type=int, default=3, help="trials per silent-failure program (0: skip)")
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--critic", default="image")
-    parser.add_argument("--tasks", nargs="*", default=None)
+    parser.add_argument("--tasks", nargs="*", default=None,
+                        help="task scenes to include (default: every task; --tasks alone: none)")
     parser.add_argument("--synthesize", type=int, default=0, help="synthesized scenes to add")
     parser.add_argument("--scenes", nargs="*", default=[], help="more scene_spec.json files or directories")
     parser.add_argument("--out", type=Path, default=Path("out/bench_subtasks"))
@@ -148,7 +149,7 @@ def main() -> None:
                         help="instead of the funnel: the code-generation table, this many seeds a program")
     args = parser.parse_args()
     args.out.mkdir(parents=True, exist_ok=True)
-    refs = [f"task:{t}" for t in (args.tasks or TASKS.names())]
+    refs = [f"task:{t}" for t in (TASKS.names() if args.tasks is None else args.tasks)]
     refs += synthesized(args.out, args.synthesize) + args.scenes
     scenes: list[tuple[str, SceneRecord, SceneSpec]] = []
     for ref in refs:
