@@ -54,6 +54,8 @@ def test_errors_are_one_line_and_exit_code_2(tmp_path: Path) -> None:
         ("verify", str(tmp_path / "nowhere.json"), "--db", str(tmp_path / "s.db")): "is neither a task",
         ("show", "ffff", "--db", str(bad)): "move it aside",
         ("verify", "task:press_stapler", "--only", "fly", "--db", str(tmp_path / "s.db")): "--only 'fly'",
+        ("verify", "goal:nope", "--db", str(tmp_path / "s.db")): "unknown goal 'nope'; goals: get_ready",
+        ("verify", "goal:tidy_the_desk@x", "--db", str(tmp_path / "s.db")): "after '@' must be an integer",
     }
     for args, message in cases.items():
         result = RUN.invoke(app, ["subtasks", *args])
@@ -80,3 +82,15 @@ def test_verify_with_a_model_writing_the_programs(tmp_path: Path, monkeypatch: p
     monkeypatch.delenv("VCAGE_LLM_MODEL")
     missing = RUN.invoke(app, ["subtasks", "verify", "task:press_stapler", "--db", db, "--llm"])
     assert missing.exit_code == 2 and "VCAGE_LLM_MODEL" in missing.output
+
+
+def test_a_goal_scene_is_the_goals_objects_placed_for_its_seed() -> None:
+    from vcage.pipeline.scene_refs import resolve
+    from vcage.planning.goals import GOALS
+
+    a, spec = resolve("goal:get_ready_for_work@1")
+    again, _ = resolve("goal:get_ready_for_work@1")
+    other, _ = resolve("goal:get_ready_for_work@2")
+    assert a == again and a.id != other.id and a.source == "goal:get_ready_for_work@1"
+    goal = next(g for g in GOALS if g.name == "get_ready_for_work")
+    assert sorted(o.name for o in spec.objects) == sorted(o.name for o in goal.objects)  # no clutter

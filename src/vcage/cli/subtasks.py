@@ -21,8 +21,9 @@ DB = typer.Option(Path("out/subtasks.db"), "--db", help="the subtask database (S
 
 @subtasks_app.command("verify")
 @cli_errors
-def verify(scenes: list[str] = typer.Argument(..., help="task:<name>[@seed], a task name, or a "
-                                             "scene_spec.json (or its directory) from `vcage synthesize`"),
+def verify(scenes: list[str] = typer.Argument(..., help="task:<name>[@seed], a task name, goal:<name>[@seed] "
+                                             "(a library goal's scene), or a scene_spec.json (or its "
+                                             "directory) from `vcage synthesize`"),
            db: Path = DB, trials: int = typer.Option(10, min=1, help="trials per candidate"),
            critic: str = typer.Option("image", help="critic that must accept each trial: image, oracle, "
                                       "vlm, or none (oracle predicates only)"),
@@ -35,10 +36,10 @@ def verify(scenes: list[str] = typer.Argument(..., help="task:<name>[@seed], a t
            busy_timeout: float = typer.Option(30.0, help="seconds to wait for another writer")) -> None:
     """Enumerate each scene's candidate subtasks, run each TRIALS times, store the verdicts."""
     from vcage.errors import ConfigError
+    from vcage.pipeline.scene_refs import resolve
     from vcage.subtasks.candidates import candidates
     from vcage.subtasks.codegen import ProgramWriter
     from vcage.subtasks.proposals import SubtaskProposer
-    from vcage.subtasks.scenes import resolve
     from vcage.subtasks.store import SubtaskStore
     from vcage.subtasks.trial import TrialConfig
     from vcage.subtasks.verify import Funnel, verify_all
