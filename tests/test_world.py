@@ -3,7 +3,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from vcage.errors import ConfigError, SceneError, SimulationError
+from vcage.errors import SceneError, SimulationError
 from vcage.scene.compose import compose
 from vcage.scene.spec import ObjectSpec, SceneSpec, TableSpec
 from vcage.sim.render import Renderer
@@ -66,8 +66,6 @@ def test_render_rgb_depth_and_segmentation(world: World) -> None:
             assert frame.depth is not None and frame.depth.shape == (96, 128)
             assert np.all(np.isfinite(frame.depth)) and 0.01 < frame.depth.min() < 5.0
         assert r.rgb("top").shape == (96, 128, 3)
-        with pytest.raises(ConfigError, match="perspective"):
-            r.depth("top")
         seg = r.segmentation("top")
         # both blocks are visible from the top and mapped to their object index; the robot is -2
         assert set(np.unique(seg)) == {-2, -1, 0, 1}
@@ -81,3 +79,17 @@ def test_render_rgb_depth_and_segmentation(world: World) -> None:
         assert abs(np.median(depth[seg_front == 0]) - expected) < 0.05
     with pytest.raises(Exception, match="closed"):
         r.rgb("top")
+
+
+def test_depth_from_the_orthographic_top_camera_is_the_height_below_it() -> None:
+    spec = SceneSpec(objects=(ObjectSpec("block", "block", (0.55, 0.0)),
+                              ObjectSpec("cup", "cup", (0.6, -0.2)), ObjectSpec("bell", "bell", (0.5, 0.2))))
+    world = compose(spec).make_world()
+    world.settle(0.3)
+    cam_z = world.data.cam_xpos[world.model.camera("top").id][2]
+    with Renderer(world, 320, 240) as r:
+        heights = cam_z - r.depth("top") - world.table_top()
+        seg = r.segmentation("top")
+    assert np.median(heights[seg == -1]) == pytest.approx(0.0, abs=1e-3)  # the table top
+    for name, top in (("block", 0.045), ("cup", 0.09), ("bell", 0.06)):  # catalog heights
+        assert heights[seg == world.object_names.index(name)].max() == pytest.approx(top, abs=2e-3), name

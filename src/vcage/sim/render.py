@@ -80,10 +80,10 @@ class Renderer:
         return r.render()
 
     def depth(self, camera: str) -> np.ndarray:
-        """Distance along the view axis in metres, from a perspective camera."""
-        if self._orthographic(camera):
-            # mujoco.Renderer linearises depth assuming a perspective projection.
-            raise ConfigError(f"depth is only available from perspective cameras, not {camera!r}")
+        """Distance along the view axis in metres, from any camera: for the orthographic ``top``
+        camera it is the height below the camera, so the camera's height minus it is the height of
+        what each pixel sees (``tests/sim/test_render.py`` holds it to known object heights)."""
+        self._check(camera)
         return self._render(camera, "depth").astype(np.float32)
 
     def pixel_size(self, camera: str) -> float | None:
