@@ -203,15 +203,12 @@ def on_scene_per_attempt(plan: Plan, cfg: GenerateConfig, prompt: str | None) ->
     already holds) for the run seed, and ``cfg`` asking for a new scene for every attempt."""
     from dataclasses import replace
 
-    from vcage.synthesis.driver import SynthesisConfig, synthesized_scene
+    from vcage.synthesis.driver import synthesized_scene
     from vcage.synthesis.scene_file import SynthesisRequest, ground_plan
 
     request = SynthesisRequest(prompt) if prompt is not None else cfg.synthesis
     assert request is not None
-    options = SynthesisConfig(seed=cfg.seed, attempts=request.attempts, perturbation=request.perturbation,
-                              lam=request.lam)
-    first = synthesized_scene(request.prompt, options)
-    plan, _ = ground_plan(plan, first)
+    plan, _ = ground_plan(plan, synthesized_scene(request, cfg.seed))
     return plan, replace(cfg, synthesis=request, synthesized=None)
 
 
@@ -224,14 +221,14 @@ def on_subtask_chain(cfg: GenerateConfig, db: Path | None, length: int,
     from vcage.subtasks.chains import compose, rebuild
     from vcage.subtasks.store import SubtaskStore
 
-    path = Path(db) if db is not None else Path(cfg.chain.db) if cfg.chain is not None else None
-    assert path is not None
-    with SubtaskStore(path, readonly=True) as store:
-        if db is None and cfg.chain is not None:
-            composed = rebuild(store, cfg.chain)
-        else:
+    if db is not None:
+        with SubtaskStore(db, readonly=True) as store:
             composed = compose(store, length, cfg.seed, scene_id)
-    return composed.plan, replace(cfg, synthesized=composed.scene, chain=composed.provenance)
+    else:
+        assert cfg.chain is not None
+        with SubtaskStore(cfg.chain.db, readonly=True) as store:
+            composed = rebuild(store, cfg.chain)
+    return composed.plan, replace(cfg, synthesized=composed.scene, chain=composed.provenance, synthesis=None)
 
 
 def cores_available() -> int:

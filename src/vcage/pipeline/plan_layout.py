@@ -73,11 +73,9 @@ def episode_scene(plan: Plan, request: SynthesisRequest, seed: int) -> Synthesiz
     ``plan``'s (grounded as :func:`~vcage.synthesis.scene_file.ground_plan` does). Raises
     :class:`~vcage.errors.SceneError` when the scene is not the one the plan was grounded on (other
     objects, colours or supports), and the synthesis' own errors when no scene came out."""
-    from vcage.synthesis.driver import SynthesisConfig, synthesized_scene
+    from vcage.synthesis.driver import synthesized_scene
 
-    cfg = SynthesisConfig(seed=seed, attempts=request.attempts, perturbation=request.perturbation,
-                          lam=request.lam)
-    grounded, scene = ground_plan(plan, synthesized_scene(request.prompt, cfg))
+    grounded, scene = ground_plan(plan, synthesized_scene(request, seed))
     if grounded.objects != plan.objects:
         got = ", ".join(f"{o.name} ({o.type})" for o in grounded.objects)
         raise SceneError(f"the scene synthesized from {request.prompt!r} for seed {seed} holds {got}, not "

@@ -24,8 +24,6 @@ generation starts every episode from it (jittered as a task's items) exactly as 
 
 from __future__ import annotations
 
-import hashlib
-import json
 import re
 from collections.abc import Sequence
 from dataclasses import asdict, dataclass
@@ -41,6 +39,7 @@ from vcage.errors import ConfigError, SceneError, SubtaskStoreError
 from vcage.planning.schema import Plan, PlanObject, Predicate, Subtask
 from vcage.scene.spec import SceneSpec
 from vcage.subtasks.records import ACCEPTED, TEMPLATE, SceneRecord, SubtaskRecord
+from vcage.subtasks.scenes import spec_digest
 from vcage.subtasks.store import SubtaskStore
 from vcage.synthesis.scene_file import FILE as SCENE_FILE
 from vcage.synthesis.scene_file import PlacedObject, SynthesizedScene, load_scene
@@ -132,16 +131,18 @@ def _search(records: Sequence[SubtaskRecord], length: int, facts: SceneFacts,
     return extend([])
 
 
-def longest(records: Sequence[SubtaskRecord], facts: SceneFacts, cap: int = 8) -> int:
-    """The length of the longest chain (up to ``cap``) the records allow."""
-    best = 0
+def longest(records: Sequence[SubtaskRecord], facts: SceneFacts, cap: int = 8, budget: int = 20_000) -> int:
+    """The length of the longest chain (up to ``cap``) the records allow, found within ``budget``
+    extensions tried (a lower bound when the budget runs out)."""
+    best, tries = 0, [budget]
 
     def grow(chain: list[SubtaskRecord]) -> None:
         nonlocal best
         best = max(best, len(chain))
-        if best >= cap:
-            return
         for step in records:
+            if best >= cap or tries[0] <= 0:
+                return
+            tries[0] -= 1
             if compatible(chain, step, facts):
                 grow([*chain, step])
 
@@ -208,7 +209,7 @@ def _chain(record: SceneRecord, steps: Sequence[SubtaskRecord], provenance: Subt
     scene = scene_of(record)
     instruction = ", then ".join(r.description for r in steps)
     scene = SynthesizedScene(instruction, scene.objects, scene.relations, provenance.seed, 0, EDITOR,
-                             source=f"{provenance.db}#{record.id}", sha256=_spec_hash(record))
+                             source=f"{provenance.db}#{record.id}", sha256=spec_digest(record.spec))
     try:
         plan = Plan(instruction=instruction,
                     objects=tuple(PlanObject(name=o.name, type=o.type, color=o.color,
@@ -233,11 +234,6 @@ def parse_predicate(text: str) -> Predicate:
         return Predicate(name=match.group(1), args=args)
     except ValidationError as exc:
         raise SubtaskStoreError(f"stored predicate {text[:60]!r}: {exc.errors()[0]['msg']}") from None
-
-
-def _spec_hash(record: SceneRecord) -> str:
-    text = json.dumps(record.spec, sort_keys=True, separators=(",", ":"))
-    return hashlib.sha256(text.encode()).hexdigest()
 
 
 def scene_of(record: SceneRecord) -> SynthesizedScene:

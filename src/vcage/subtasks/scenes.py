@@ -11,6 +11,7 @@ from __future__ import annotations
 import hashlib
 import json
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -24,10 +25,15 @@ from vcage.tasks.runner import make_task, place_scene
 SPEC_FILE = "scene_spec.json"
 
 
+def spec_digest(data: dict[str, Any]) -> str:
+    """The SHA-256 (hex) of a scene spec's canonical JSON (``SceneSpec.to_dict()``)."""
+    text = json.dumps(data, sort_keys=True, separators=(",", ":"))
+    return hashlib.sha256(text.encode()).hexdigest()
+
+
 def scene_id(spec: SceneSpec) -> str:
-    """A stable id of ``spec``: the first 12 hex digits of the SHA-256 of its canonical JSON."""
-    text = json.dumps(spec.to_dict(), sort_keys=True, separators=(",", ":"))
-    return hashlib.sha256(text.encode()).hexdigest()[:12]
+    """A stable id of ``spec``: the first 12 hex digits of :func:`spec_digest`."""
+    return spec_digest(spec.to_dict())[:12]
 
 
 def task_scene(name: str, seed: int = 0) -> tuple[SceneRecord, SceneSpec]:

@@ -39,7 +39,7 @@ from vcage.synthesis.refine import RefineConfig, refine
 from vcage.synthesis.relations_check import Held, relations_held
 from vcage.synthesis.retrieval import Retrieval, retriever
 from vcage.synthesis.scene_file import FILE as SCENE_FILE
-from vcage.synthesis.scene_file import SynthesizedScene, settled_scene, yaw_of
+from vcage.synthesis.scene_file import SynthesisRequest, SynthesizedScene, settled_scene, yaw_of
 from vcage.synthesis.settle import rests_on, scene_spec, settle
 from vcage.synthesis.text import content
 from vcage.synthesis.views import render_top
@@ -173,11 +173,13 @@ def synthesize(prompt: str, cfg: SynthesisConfig | None = None, sink: Sink | Non
                          "Try another seed, more attempts, or a prompt with fewer objects")
 
 
-def synthesized_scene(prompt: str, cfg: SynthesisConfig) -> SynthesizedScene:
-    """The settled scene one run for ``prompt`` makes (offline: retrieval, description and the
-    compositor), without writing its artefacts: what a generation attempt starts from."""
+def synthesized_scene(request: SynthesisRequest, seed: int) -> SynthesizedScene:
+    """The settled scene one run for ``request`` with ``seed`` makes (offline: retrieval, description
+    and the compositor), without writing its artefacts: what a generation attempt starts from."""
     sink = MemorySink()
-    synthesize(prompt, cfg, sink)
+    cfg = SynthesisConfig(seed=seed, attempts=request.attempts, perturbation=request.perturbation,
+                          lam=request.lam)
+    synthesize(request.prompt, cfg, sink)
     return SynthesizedScene.from_dict(sink.data[SCENE_FILE])
 
 
