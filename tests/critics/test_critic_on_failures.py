@@ -28,6 +28,7 @@ BLOCK_PAD = (O("block", "block", (0.5, -0.12)), O("pad", "mouse_pad", (0.58, 0.1
 BREAD_BASKET = (O("bread", "bread", (0.5, -0.12)), O("basket", "basket", (0.58, 0.12)))
 BELL = (O("bell", "bell", (0.55, 0.05)),)
 CLOCK = (O("clock", "alarm_clock", (0.55, 0.05)),)
+STAPLER = (O("stapler", "stapler", (0.55, -0.05), yaw=1.0),)
 MOUSE_PAD = (O("mouse", "mouse", (0.5, -0.12)), O("pad", "mouse_pad", (0.55, 0.12)))
 TWO_BLOCKS = (O("a", "block", (0.5, -0.15)), O("b", "block", (0.55, 0.1)))
 STACK = (O("a", "block", (0.5, -0.12)), O("b", "block", (0.55, 0.1)))
@@ -39,6 +40,7 @@ SCENARIOS: dict[str, tuple[tuple[O, ...], Subtask]] = {
     "inside": (BREAD_BASKET, put_in("bread", "basket", "the bread is in the basket")),
     "pressed": (BELL, press("bell", "the bell is rung")),
     "upright": (CLOCK, press("clock", "the clock's button is pressed")),
+    "pressed_lever": (STAPLER, press("stapler", "the stapler is pressed")),
     "on_table": (MOUSE_PAD, _sub("pick_and_place", {"obj": "mouse", "xy": [0.55, 0.02]},
                                  ("on_table", ("mouse",)), ("released", ("mouse",)))),
     "near": (TWO_BLOCKS, _sub("pick_and_place", {"obj": "a", "xy": [0.55, 0.04]},
@@ -61,6 +63,10 @@ FAILURES = [
     ("on", "no_release", 0, "released(block)"),
     ("pressed", "press_hover", 0, "pressed(bell)"),
     ("pressed", "press_miss", 0, "pressed(bell)"),
+    ("pressed", "press_light", 0, "pressed(bell)"),
+    ("pressed", "press_light", 3, "pressed(bell)"),
+    ("upright", "press_light", 1, "pressed(clock)"),
+    ("pressed_lever", "press_light", 3, "pressed(stapler)"),
     ("upright", "knock_over", 1, "upright(clock)"),
     ("on_table", "off_target", 2, "on_table(mouse)"),
     ("near", "off_target", 0, "near(a, b)"),

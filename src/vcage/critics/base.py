@@ -25,7 +25,7 @@ from vcage.registry import Registry
 class View:
     rgb: np.ndarray  # (H, W, 3) uint8
     segmentation: np.ndarray  # (H, W) int32: object index into Observation.labels, -1 other, -2 robot
-    depth: np.ndarray | None = None  # (H, W) metres along the view axis (perspective cameras)
+    depth: np.ndarray | None = None  # (H, W) metres along the view axis (orthographic: straight down)
     pixel_size: float | None = None  # metres per pixel on the table (orthographic cameras)
 
 
@@ -36,6 +36,7 @@ class Observation:
     before: dict[str, View] = field(default_factory=dict)  # camera -> view before the subtask
     after: dict[str, View] = field(default_factory=dict)  # camera -> view after it
     during: dict[str, View] = field(default_factory=dict)  # at the subtask's deepest moment (a press)
+    types: dict[str, str] = field(default_factory=dict)  # object name -> catalog type (from the plan)
     oracle: dict[str, bool] = field(default_factory=dict)  # ground truth (the oracle critic only)
 
 

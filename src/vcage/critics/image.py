@@ -14,7 +14,13 @@ space:
 - ``released(a)``: after the retreat, the robot does not touch ``a`` in every view that shows it
   (a projection overlap in one view is not contact); ``a`` hidden in every view is not released.
 - ``pressed(x)``: in the views at the subtask's deepest moment the robot touches ``x`` (front view,
-  at the same depth) and covers it (top view).
+  at the same depth) and covers it (top view), and, where the top view has depth and ``x``'s type
+  is known, the hand went deep enough: the orthographic top view's depth gives heights above the
+  table, the robot's highest point over ``x``'s outline is the top of the wrist, :data:`HAND_TOP`
+  above the hand's centre between the fingertips when the hand points down (as it does to press),
+  and at a full press that centre is :data:`FINGER_CONTACT` minus the button's travel (a lever's
+  stroke), scaled by ``x``'s size, above ``x``'s highest point before. A press that stops short of
+  :data:`PRESS_SHARE` of that is refused.
 - ``upright(x)``: ``x``'s top-view area (orthographic, so true to size wherever it stands) and the
   spread of its outline are close to what they were before, allowing for what the robot can hide;
   its front-view height did not drop.
@@ -25,9 +31,9 @@ space:
 - ``lifted(a)``: in the front view ``a``'s lowest row rose by at least :data:`LIFT_ROWS` pixels
   since before the subtask, and it is not over another object's top-view hull (it hangs in the air).
 
-Every predicate of :mod:`vcage.vocabulary` has a check in ``IMAGE_CHECKS``. Known blind spot: a
-press that touches the button but moves it less than its travel (a few millimetres, about one pixel
-of the front view) looks like a press.
+Every predicate of :mod:`vcage.vocabulary` has a check in ``IMAGE_CHECKS``. Without the top view's
+depth (or the object's type), a press that touches the button but moves it less than its travel (a
+few millimetres, about one pixel of the front view) looks like a press.
 """
 
 from __future__ import annotations
@@ -36,6 +42,7 @@ from collections.abc import Callable
 
 import numpy as np
 
+from vcage.assets.catalog import CATALOG
 from vcage.critics.base import CRITICS, Critic, CriticConfig, Observation, Verdict, View
 from vcage.critics.masks import TOUCH, best_shift, centroid_in, dilate, hull, rows_of, shift, spread, touch
 from vcage.registry import Registry
@@ -53,6 +60,15 @@ HEIGHT_RATIO = 0.8  # front-view height after / before for an object that stayed
 COL_MARGIN = 2  # pixels of column separation for left_of / right_of
 NEAR = 0.1  # metres between the centroids for ``near`` (the oracle's distance)
 LIFT_ROWS = 8  # front-view pixel rows (of 240) an object's bottom must rise to count as lifted
+# The Panda's geometry, seen from above with the hand pointing down: its highest point above the
+# hand's centre (the TCP, between the fingertips), and the TCP's height above what the closed
+# fingertips touch. Both are held to the model by tests/critics/test_press_depth.py.
+HAND_TOP = 0.307  # metres
+FINGER_CONTACT = 0.033  # metres
+# Share of a full press the hand must reach: a button's travel (the oracle asks for all of it; the
+# rest is the estimate's margin), a lever's stroke (its full close; the oracle asks for 0.15 of the
+# stapler's 0.25 rad, 0.6 of the stroke)
+PRESS_SHARE = {"button": 0.75, "lever": 0.5}
 
 
 class ImageCritic(Critic):
@@ -182,7 +198,40 @@ def _pressed(obs: Observation, x: str) -> tuple[bool, str]:
     outline = hull(mx_top) if mx_top.any() else mx_top
     if not np.any(dilate(top.segmentation == ROBOT, TOUCH) & outline):
         return False, f"the hand was not over {x}"
+    short = _press_shortfall(obs, x)
+    if short is not None and short > 0:
+        return False, f"the hand stopped {1000 * short:.1f} mm short of pressing {x} down its travel"
     return True, "the hand touched and covered it at its lowest"
+
+
+def _heights(view: View) -> np.ndarray | None:
+    """Heights above the table of what each pixel of an orthographic view with depth sees."""
+    if view.depth is None or view.pixel_size is None or not np.any(view.segmentation == -1):
+        return None
+    return float(np.median(view.depth[view.segmentation == -1])) - view.depth
+
+
+def _press_shortfall(obs: Observation, x: str) -> float | None:
+    """How far (metres) the hand stayed above :data:`PRESS_SHARE` of a full press of ``x`` at its
+    lowest (negative: deep enough); None where the views or ``x``'s type cannot tell."""
+    before, during = obs.before.get(TOP), obs.during.get(TOP)
+    otype = CATALOG.get(obs.types[x]) if x in obs.types and obs.types[x] in CATALOG else None
+    if before is None or during is None or otype is None:
+        return None
+    point = next((p for p in otype.functional_points if p.joint and p.name == obs.subtask.args.get("point")),
+                 next((p for p in otype.functional_points if p.joint), None))
+    hb, hd = _heights(before), _heights(during)
+    mask = _mask(obs, before, x)
+    if point is None or point.kind not in PRESS_SHARE or hb is None or hd is None or not mask.any():
+        return None
+    over = (during.segmentation == ROBOT) & mask
+    if not over.any():
+        return None
+    top = float(hb[mask].max())  # the button (lever) at rest: the object's highest point
+    scale = top / point.pos[2]  # the press point at rest is the highest point
+    full = (point.travel if point.kind == "button" else point.stroke) * scale
+    tcp = float(hd[over].max()) - HAND_TOP
+    return (tcp - top) - (FINGER_CONTACT - PRESS_SHARE[point.kind] * full)
 
 
 def _hidden(view: View, mask: np.ndarray) -> int:

@@ -19,7 +19,7 @@ from vcage.sim.world import World
 from vcage.skills.playback import Recording
 
 CRITIC_CAMERAS = ("top", "front")  # the views a critic gets: top-down (orthographic) and front
-DEPTH_CAMERAS = ("front",)  # ... with depth where the camera is perspective (RGB-D)
+DEPTH_CAMERAS = ("top", "front")  # ... with depth (the top view's: heights, for how deep a press went)
 
 
 class Outcome(Protocol):
@@ -71,7 +71,8 @@ class Verifier:
         t1 = time.perf_counter()
         self.timing.critic_views += t1 - t0
         obs = Observation(subtask=self.plan.subtasks[outcome.index], labels=tuple(self.world.object_names),
-                          before=self._before, after=after, during=during, oracle=outcome.oracle)
+                          before=self._before, after=after, during=during, oracle=outcome.oracle,
+                          types={n: self.world.object(n).type_name for n in self.world.object_names})
         verdict = self.critic.judge(obs)
         self.timing.critic_judge += time.perf_counter() - t1
         if not verdict.accept:

@@ -17,7 +17,7 @@ from vcage.sim.world import World
 from vcage.skills.playback import Recording
 
 CRITIC_CAMERAS = ("top", "front")
-DEPTH_CAMERAS = ("front",)
+DEPTH_CAMERAS = ("top", "front")
 
 
 def views(renderer: Renderer | None) -> dict[str, View]:
@@ -43,6 +43,7 @@ def deepest(world: World, renderer: Renderer | None, rec: Recording, start: int,
 
 def judge(critic: Critic, subtask: Subtask, world: World, before: dict[str, View], during: dict[str, View],
           after: dict[str, View], oracle: dict[str, bool]) -> Verdict:
+    types = {n: world.object(n).type_name for n in world.object_names}
     obs = Observation(subtask=subtask, labels=tuple(world.object_names), before=before, after=after,
-                      during=during, oracle=oracle)
+                      during=during, oracle=oracle, types=types)
     return critic.judge(obs)
