@@ -31,7 +31,7 @@ import pickle
 import time
 from collections.abc import Iterable
 from concurrent.futures import ProcessPoolExecutor
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 os.environ.setdefault("LP_NUM_THREADS", "1")  # one rasteriser thread: a worker is one core
@@ -39,6 +39,7 @@ os.environ.setdefault("LP_NUM_THREADS", "1")  # one rasteriser thread: a worker 
 import numpy as np  # noqa: E402
 
 from vcage.critics import Critic, CriticConfig, Observation, Verdict, make_critic  # noqa: E402
+from vcage.critics.base import View  # noqa: E402
 from vcage.pipeline.config import GenerateConfig  # noqa: E402
 from vcage.pipeline.episode import Timing  # noqa: E402
 from vcage.pipeline.plan_layout import plan_layout  # noqa: E402
@@ -183,6 +184,18 @@ def report(samples: list[Sample], critic: str, accepts: list[bool]) -> None:
             print(row(f"{label} {value}"[:28], [samples[k] for k in pick], [accepts[k] for k in pick]))
 
 
+def _same(obs: Observation) -> Observation:
+    return obs
+
+
+def _no_top_depth(obs: Observation) -> Observation:
+    """``obs`` without the top view's depth: what the image critic saw before it read press depth."""
+    def strip(views: dict[str, View]) -> dict[str, View]:
+        return {cam: replace(v, depth=None) if cam == "top" else v for cam, v in views.items()}
+
+    return replace(obs, before=strip(obs.before), during=strip(obs.during), after=strip(obs.after))
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -215,10 +228,12 @@ def main() -> None:
     print("succ/fail: the oracle's labels; scenes: distinct instantiated scenes; bal.acc: mean of the "
           "accept rate on successes and the reject rate on failures; FA: failures accepted; FR: "
           "successes rejected; n/a: empty denominator")
-    for name in CRITICS:
+    variants = [(name, name, _same) for name in CRITICS]
+    variants.insert(1, ("image", "image, no top-view depth", _no_top_depth))  # the critic before it had it
+    for name, label, seen in variants:
         critic = make_critic(CriticConfig(name))
-        verdicts = [critic.judge(s.obs) for s in samples]
-        report(samples, name, [v.accept for v in verdicts])
+        verdicts = [critic.judge(seen(s.obs)) for s in samples]
+        report(samples, label, [v.accept for v in verdicts])
         if args.show_errors:
             for s, v in zip(samples, verdicts, strict=True):
                 if v.accept != s.success:
