@@ -178,7 +178,7 @@ def _released(obs: Observation, a: str) -> tuple[bool, str]:
     if not seen:  # hidden in every view: inside the hand, or gone; no view shows it let go
         return False, f"{a} is not visible in any view after the subtask"
     touching = [cam for cam, view in seen.items()
-                if touch(view.segmentation == ROBOT, _mask(obs, view, a), view.depth)]
+                if touch(view.segmentation == ROBOT, _mask(obs, view, a), _touch_depth(view))]
     if touching and len(touching) == len(seen):
         return False, f"the robot still touches {a} in the {' and '.join(touching)} views"
     return True, "the robot is clear of it"
@@ -202,6 +202,13 @@ def _pressed(obs: Observation, x: str) -> tuple[bool, str]:
     if short is not None and short > 0:
         return False, f"the hand stopped {1000 * short:.1f} mm short of pressing {x} down its travel"
     return True, "the hand touched and covered it at its lowest"
+
+
+def _touch_depth(view: View) -> np.ndarray | None:
+    """The depth ``touch`` compares: a perspective view's. The top view's depth is height, and a hand
+    holding an object from above stands higher than the object it holds, so there contact is judged
+    from the outlines alone."""
+    return view.depth if view.pixel_size is None else None
 
 
 def _heights(view: View) -> np.ndarray | None:
