@@ -10,16 +10,12 @@ from __future__ import annotations
 import time
 from typing import Any, Protocol
 
-import numpy as np
-
 from vcage.critics.base import Critic, Observation, View
 from vcage.planning.schema import Plan, Subtask
 from vcage.sim.render import Renderer
 from vcage.sim.world import World
 from vcage.skills.playback import Recording
-
-CRITIC_CAMERAS = ("top", "front")  # the views a critic gets: top-down (orthographic) and front
-DEPTH_CAMERAS = ("top", "front")  # ... with depth (the top view's: heights, for how deep a press went)
+from vcage.subtasks.judge import deepest, render_views
 
 
 class Outcome(Protocol):
@@ -36,14 +32,6 @@ class Timed(Protocol):
 
     critic_views: float  # rendering the views (and setting the state of the "during" frame)
     critic_judge: float  # the critic's judgement of them
-
-
-def render_views(renderer: Renderer, cameras: tuple[str, ...] = CRITIC_CAMERAS,
-                 depth_cameras: tuple[str, ...] = DEPTH_CAMERAS) -> dict[str, View]:
-    """The critic's views of the world as it is now."""
-    return {cam: View(renderer.rgb(cam), renderer.segmentation(cam),
-                      renderer.depth(cam) if cam in depth_cameras else None, renderer.pixel_size(cam))
-            for cam in cameras}
 
 
 class Verifier:
@@ -81,14 +69,4 @@ class Verifier:
 
     def _deepest(self, outcome: Outcome) -> dict[str, View]:
         """Views of the recorded frame where the hand was lowest during the subtask."""
-        rec = self.recording
-        if self.renderer is None or outcome.end <= outcome.start or not rec.states:
-            return {}
-        heights = [p[2] for p in rec.ee_pos[outcome.start:outcome.end]]
-        frame = outcome.start + int(np.argmin(heights))
-        now = self.world.get_state()
-        self.world.set_state(rec.states[frame])
-        try:
-            return self._views()
-        finally:
-            self.world.set_state(now)
+        return deepest(self.world, self.renderer, self.recording, outcome.start, outcome.end)

@@ -16,16 +16,20 @@ from vcage.sim.render import Renderer
 from vcage.sim.world import World
 from vcage.skills.playback import Recording
 
-CRITIC_CAMERAS = ("top", "front")
-DEPTH_CAMERAS = ("top", "front")
+CRITIC_CAMERAS = ("top", "front")  # the views a critic gets: top-down (orthographic) and front
+DEPTH_CAMERAS = ("top", "front")  # ... with depth (the top view's: heights, for how deep a press went)
+
+
+def render_views(renderer: Renderer, cameras: tuple[str, ...] = CRITIC_CAMERAS,
+                 depth_cameras: tuple[str, ...] = DEPTH_CAMERAS) -> dict[str, View]:
+    """The critic's views of the world as it is now (the pipeline's verifier renders the same)."""
+    return {cam: View(renderer.rgb(cam), renderer.segmentation(cam),
+                      renderer.depth(cam) if cam in depth_cameras else None, renderer.pixel_size(cam))
+            for cam in cameras}
 
 
 def views(renderer: Renderer | None) -> dict[str, View]:
-    if renderer is None:
-        return {}
-    return {cam: View(renderer.rgb(cam), renderer.segmentation(cam),
-                      renderer.depth(cam) if cam in DEPTH_CAMERAS else None, renderer.pixel_size(cam))
-            for cam in CRITIC_CAMERAS}
+    return render_views(renderer) if renderer is not None else {}
 
 
 def deepest(world: World, renderer: Renderer | None, rec: Recording, start: int, end: int) -> dict[str, View]:
