@@ -16,7 +16,7 @@ def synthesize(prompt: str = typer.Argument(..., help="the scene, e.g. 'organize
                out: Path = typer.Option(Path("out/synthesis"), help="directory for the artefacts"),
                seed: int = typer.Option(0), attempts: int = typer.Option(3, min=1),
                perturb: str = typer.Option("none", help="realism perturbation of the offline goal image: "
-                                           "none, shift, color, blur, jpeg, drop, realistic"),
+                                           "none, shift, color, blur, jpeg, drop, turn, realistic"),
                lam: float = typer.Option(1.0, help="lambda: weight of the semantic cost in the refine step"),
                reach: bool = typer.Option(True, help="keep objects within the arm's top-down reach"),
                editor: str = typer.Option("compositor", help="goal images: compositor (offline) or model "

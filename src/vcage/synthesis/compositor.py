@@ -69,6 +69,9 @@ class Compositor(ImageEditor):
     def edit(self, init: TopView, empty: np.ndarray, desc: SceneDescription,
              rng: np.random.Generator) -> EditResult:
         poses = goal_layout(desc, init, self.table, rng)
+        if self.perturbation.turn:
+            span = np.radians(self.perturbation.turn)
+            poses = {n: (x, y, yaw + float(rng.uniform(-span, span))) for n, (x, y, yaw) in poses.items()}
         dropped: tuple[str, ...] = ()
         if self.perturbation.drop:
             hosts = {r.b for r in desc.relations if r.kind in ("on", "inside")}

@@ -8,7 +8,8 @@
    steps) then fine (full resolution, 2 degree steps, sub-pixel peak).
 3. **Assign**: objects that look alike (same type, colour and scale) share candidate peaks and get
    the assignment of least total cost; then no two objects may claim one place unless one rests on
-   the other (the larger template keeps it).
+   the other (an object whose place agrees with its template keeps it against one whose place does
+   not, e.g. an object the image model dropped; between equals the larger template keeps it).
 4. **Lose**: an object whose best place agrees with its template on under half its pixels is lost.
 5. **Lift** the origin pixel to the table with the camera's exact geometry
    (:class:`~vcage.synthesis.camera.OrthoCamera`), and the image rotation to a yaw.
@@ -290,13 +291,17 @@ def _assign(groups: dict[tuple[object, ...], list[_Template]],
 
 
 def _exclusive(templates: list[_Template], chosen: dict[str, Candidate],
-               cands: dict[str, list[Candidate]], stacked: set[frozenset[str]]) -> dict[str, Candidate]:
-    """No two objects at one place unless one rests on the other: the larger template keeps the place
-    (a small object fits inside a larger one of its colour, never the other way), the smaller takes
-    its next candidate that is free."""
+               cands: dict[str, list[Candidate]], stacked: set[frozenset[str]],
+               agrees: Mapping[str, bool]) -> dict[str, Candidate]:
+    """No two objects at one place unless one rests on the other: an object whose chosen place agrees
+    with its template keeps it against one whose place does not (an object missing from the goal
+    image finds its best place where another object is), and between equals the larger template
+    keeps it (a small object fits inside a larger one of its colour, never the other way); the other
+    takes its next candidate that is free."""
     taken: list[tuple[_Template, Candidate]] = []
     out: dict[str, Candidate] = {}
-    for t in sorted(templates, key=lambda t: -float((t.weight[..., 0] >= 0.5).sum())):
+    for t in sorted(templates, key=lambda t: (not agrees.get(t.name, False),
+                                              -float((t.weight[..., 0] >= 0.5).sum()))):
         if t.name not in chosen:
             continue
         options = [chosen[t.name]] + [c for c in cands[t.name] if c != chosen[t.name]]
@@ -336,7 +341,10 @@ def match(init: TopView, empty: np.ndarray, goal: np.ndarray,
     groups: dict[tuple[object, ...], list[_Template]] = {}
     for t in templates:
         groups.setdefault(t.look, []).append(t)
-    chosen = _exclusive(templates, _assign(groups, cands), cands, stacked or set())
+    assigned = _assign(groups, cands)
+    agrees = {t.name: _inliers(t, scene, *_fine(t, scene, *assigned[t.name][1:])[1:]) >= MIN_INLIERS
+              for t in templates if t.name in assigned}
+    chosen = _exclusive(templates, assigned, cands, stacked or set(), agrees)
     matches: dict[str, Match] = {}
     for name in init.names:
         x0, y0, yaw0 = init.poses[name]

@@ -1,7 +1,8 @@
 """Realism perturbations of a goal image: what image models do to a scene they redraw.
 
 A global shift and scale (the model redraws the frame slightly off), colour jitter, blur, JPEG
-compression, and a dropped object. Each is seeded; :data:`PRESETS` names the sweeps the tests and
+compression, a dropped object, and objects turned beyond the layout (a model that redraws an object
+at another heading). Each is seeded; :data:`PRESETS` names the sweeps the tests and
 benchmarks use.
 """
 
@@ -22,6 +23,7 @@ class Perturbation:
     blur: float = 0.0  # Gaussian blur radius, pixels
     jpeg: int = 0  # JPEG quality (0: none)
     drop: bool = False  # leave one object out
+    turn: float = 0.0  # degrees, largest extra yaw given to each object drawn
 
     def to_dict(self) -> dict[str, object]:
         return asdict(self)
@@ -34,6 +36,7 @@ PRESETS: dict[str, Perturbation] = {
     "blur": Perturbation(blur=1.5),
     "jpeg": Perturbation(jpeg=40),
     "drop": Perturbation(drop=True),
+    "turn": Perturbation(turn=60.0),
     "realistic": Perturbation(shift=8.0, scale=0.02, color=0.05, blur=0.8, jpeg=70),
 }
 
