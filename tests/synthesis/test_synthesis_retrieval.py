@@ -8,7 +8,7 @@ from vcage.assets.catalog import CATALOG
 from vcage.errors import ConfigError
 from vcage.synthesis.bm25 import BM25
 from vcage.synthesis.retrieval import affords, retriever
-from vcage.synthesis.text import edit_distance, misspells
+from vcage.synthesis.text import edit_distance, head, misspells, stem
 
 PARAPHRASES = [
     ("a coffee mug", "mug"), ("loaf of bread", "bread"), ("a cellphone", "phone"), ("the hamper", "basket"),
@@ -54,3 +54,40 @@ def test_misspellings_are_within_one_edit_per_four_letters() -> None:
     assert misspells("stappler", ["stapler"]) and misspells("mugg", ["mug"])
     assert not misspells("pineapple", ["apple"]) and not misspells("keyboard", ["board"])
     assert retriever().search("a stappler").best == "stapler"
+
+
+@pytest.mark.parametrize(("phrase", "noun"), [
+    ("a frying pan", ("fry", "pan")), ("a glass of wine", ("glass",)), ("a tray to carry cups", ("tray",)),
+    ("a pair of headphones", (stem("headphones"),)), ("a pack of playing cards", ("play", "card")),
+    ("a board showing a QR code", ("board",)), ("a wooden rolling pin", ("roll", "pin")),
+    ("a desk bell you ring for service", ("desk", "bell")), ("the red one", None),
+    ("something to write with", None)])
+def test_the_head_noun_is_the_last_word_of_the_first_noun_phrase(phrase: str, noun: tuple | None) -> None:
+    assert head(phrase) == noun
+
+
+@pytest.mark.parametrize("phrase", ["a frying pan", "a coffee machine", "a kitchen knife", "a glass of wine",
+                                    "a bread knife", "a phone charger", "a toy robot"])
+def test_a_phrase_whose_head_names_no_type_is_no_match(phrase: str) -> None:
+    """The modifiers name catalog types (fries, mug, sponge, jar, bread, phone, toys): ranking by
+    meaning finds them, naming does not."""
+    assert retriever().search(phrase).found
+    result = retriever().find(phrase)
+    assert not result.found and repr(head(phrase)[-1]) in (result.no_match or "")
+
+
+@pytest.mark.parametrize(("phrase", "expected"), [("a small toy brick", "block"), ("a drink mat", "coaster"),
+                                                  ("a cheap cellphone", "phone"),
+                                                  ("a pencil cup", "pen_holder")])
+def test_types_the_head_names_come_first(phrase: str, expected: str) -> None:
+    """Synonyms, compounds named as a whole ("drink mat") and closed compounds ("shoebox") name a type."""
+    assert retriever().find(phrase).best == expected
+
+
+def test_a_closed_compound_ending_in_a_types_name_names_it() -> None:
+    assert "shoe_box" in retriever().find("an open shoebox").names()
+
+
+def test_a_phrase_without_a_head_noun_is_ranked_by_meaning() -> None:
+    assert retriever().find("something to drink from").names() == retriever().search(
+        "something to drink from").names()

@@ -122,7 +122,7 @@ def unknown_phrases(text: str) -> tuple[list[str], dict[str, Retrieval]]:
     for phrase in noun_phrases(text):
         if not content(phrase):
             continue
-        found[phrase] = retriever().search(phrase, k=3)
+        found[phrase] = retriever().find(phrase, k=3)
         if not found[phrase].found and not set(goal_tokens(phrase)) & vocab:
             unknown.append(phrase)
     return unknown, found

@@ -6,6 +6,12 @@ ranked by BM25 over synonym-expanded words and by character n-gram TF-IDF (for m
 the two rankings are fused by reciprocal rank. Affordance filters keep only types that can do what
 the scene needs. A request whose words name nothing the catalog has gets an answer with no hits
 and the reason: "no suitable object" is a result, not an error.
+
+:meth:`Retriever.search` ranks a request by meaning, themes included ("serve tea" suggests cups).
+:meth:`Retriever.find` answers a phrase that names one object ("a frying pan"): the type must be
+what the phrase's head noun names (its name, category, tags or the head of its description, a
+synonym or misspelling of one, or a closed compound ending in one: "cheeseburger"), so words
+that only qualify the head ("frying pan", "coffee machine") do not make a match.
 """
 
 from __future__ import annotations
@@ -16,7 +22,16 @@ from typing import Literal
 from vcage.assets.catalog import CATALOG, ObjectType
 from vcage.errors import ConfigError
 from vcage.synthesis.bm25 import BM25
-from vcage.synthesis.text import GENERIC_STEMS, char_ngrams, content, expand, misspells, tokens
+from vcage.synthesis.text import (
+    GENERIC_STEMS,
+    char_ngrams,
+    content,
+    expand,
+    head,
+    misspells,
+    names_of,
+    tokens,
+)
 from vcage.synthesis.tfidf import CharTfidf
 
 Affordance = Literal["grasp", "support", "container", "placement", "functional"]
@@ -25,6 +40,7 @@ RRF_K = 60  # reciprocal rank fusion constant (Cormack et al.)
 NAME_REPEAT = 3  # a type's own name words count this many times in its document
 TYPO_COSINE = 0.3  # without a shared word: a misspelling of one of its words, at least this n-gram cosine
 MIN_COSINE = 0.1  # below this the n-gram ranking does not vote for a type
+COMPOUND_MIN = 3  # letters of a naming word that may end a closed compound ("shoebox" -> box)
 
 
 def affords(t: ObjectType, need: str) -> bool:
@@ -52,6 +68,15 @@ def document(t: ObjectType) -> str:
     for f in t.functional_points:
         parts.append(f"{f.kind} press functional")
     return " ".join(parts)
+
+
+def naming_words(t: ObjectType) -> frozenset[str]:
+    """The stems that name a type: its name, category, tags and the head of its description."""
+    out = set(tokens(t.name.replace("_", " "))) | set(tokens(t.category)) | set(tokens(" ".join(t.tags)))
+    described = head(t.description)
+    if described is not None:
+        out.add(described[-1])
+    return frozenset(out)
 
 
 @dataclass(frozen=True)
@@ -98,6 +123,7 @@ class Retriever:
         self.types = list(types) if types is not None else list(CATALOG.values())
         docs = [document(t) for t in self.types]
         self.words = [frozenset(tokens(d)) for d in docs]
+        self.naming = {t.name: naming_words(t) for t in self.types}
         self.bm25 = BM25([tokens(d) for d in docs])
         self.tfidf = CharTfidf([char_ngrams(d) for d in docs])
 
@@ -135,6 +161,29 @@ class Retriever:
         order = sorted(keep, key=lambda i: (-fused[i], -bm[i], -cos[i], self.types[i].name))[:k]
         return Retrieval(query, tuple(Hit(self.types[i].name, fused[i], bm[i], cos[i]) for i in order),
                          filters=require)
+
+    def find(self, phrase: str, k: int = 5, require: tuple[str, ...] = ()) -> Retrieval:
+        """The ``k`` best types for ``phrase``, which names one object (see the module's docstring):
+        no match unless its head noun names a type :meth:`search` finds; those it names come first,
+        each group in :meth:`search`'s order. A phrase without a head noun ("something to write
+        with") is ranked as :meth:`search` ranks it."""
+        ranked = self.search(phrase, len(self.types), require)
+        noun = head(phrase)
+        if noun is None or not ranked.found:
+            return Retrieval(ranked.query, ranked.hits[:k], ranked.no_match, ranked.filters)
+        named = names_of(noun)
+        grounded = [self._names(noun[-1], named, self.naming[h.type]) for h in ranked.hits]
+        if not any(grounded):
+            return Retrieval(phrase, no_match=f"no catalog type is a {noun[-1]!r} (its other words match "
+                                              f"{', '.join(ranked.names()[:3])})", filters=require)
+        hits = [h for h, g in zip(ranked.hits, grounded, strict=True) if g]
+        hits += [h for h, g in zip(ranked.hits, grounded, strict=True) if not g]
+        return Retrieval(phrase, tuple(hits[:k]), filters=require)
+
+    @staticmethod
+    def _names(noun: str, named: set[str], naming: frozenset[str]) -> bool:
+        return bool(named & naming) or misspells(noun, naming) or any(
+            len(w) >= COMPOUND_MIN and len(noun) > len(w) and noun.endswith(w) for w in naming)
 
 
 _DEFAULT: Retriever | None = None

@@ -48,7 +48,8 @@ SYNONYMS: tuple[tuple[str, str], ...] = (
     ("switch", "switch light_switch toggle rocker"),
     ("block", "block blocks brick bricks"),
     ("dice", "dice die"),
-    ("rubik cube", "rubik rubiks puzzle_cube speedcube"),
+    ("rubik cube", "rubik rubiks puzzle_cube speedcube puzzle"),
+    ("qr board", "qr qrcode barcode sign signboard placard"),
     ("tennis ball", "ball balls tennis"),
     ("toy car", "car cars vehicle truck"),
     ("playing card", "card cards playing_card"),
@@ -74,3 +75,6 @@ arrange organize organise tidy clean get make bring take give find want need som
 large little one two three table tabletop scene top left right front behind near next
 pair pairs piece pieces bunch couple
 """.split())  # noqa: SIM905
+
+# nouns of amount: in "a pack of cards" the object is what follows "of"
+QUANTITIES = frozenset("pack packet stack pile heap handful".split())  # noqa: SIM905

@@ -1,17 +1,24 @@
-"""Tokens for retrieval: words, a light stemmer, stop words, synonym expansion, character n-grams."""
+"""Tokens for retrieval: words, a light stemmer, stop words, synonym expansion, the head noun of a
+phrase, character n-grams."""
 
 from __future__ import annotations
 
 import re
 from collections.abc import Iterable
 
-from vcage.synthesis.synonyms import GENERIC, SYNONYMS, TOPICS
+from vcage.synthesis.synonyms import GENERIC, QUANTITIES, SYNONYMS, TOPICS
 
 STOP = frozenset("""
 a an the my our your his her their its this that these those to for of and or please can could
 would you will i we me us it be is are get go do just now then with at by let lets in on into
 onto from as
 """.split())  # noqa: SIM905
+# words that end the first noun phrase of a description ("a glass of wine", "a tray to carry cups")
+PHRASE_END = frozenset("""
+of for with to that which who whose where on in into onto inside from at by under over beside near
+and or than like you i we they he she it someone
+""".split())  # noqa: SIM905
+DETERMINERS = frozenset("a an the some its their my your his her this these those".split())  # noqa: SIM905
 SYNONYM_WEIGHT = 1.0  # a word's own synonyms count fully
 TOPIC_WEIGHT = 0.5  # a theme's suggestions count half
 
@@ -52,6 +59,7 @@ def _groups(table: Iterable[tuple[str, str]]) -> dict[str, list[str]]:
 _SYN = _groups(SYNONYMS)
 _TOPIC = _groups(TOPICS)
 GENERIC_STEMS = frozenset(stem(w) for w in GENERIC)
+QUANTITY_STEMS = frozenset(stem(w) for w in QUANTITIES)
 
 
 def expand(text: str) -> dict[str, float]:
@@ -72,6 +80,41 @@ def expand(text: str) -> dict[str, float]:
         for c in _TOPIC.get(g, ()):
             add(c, TOPIC_WEIGHT)
     return weights
+
+
+def head(text: str) -> tuple[str, ...] | None:
+    """The stemmed head noun of the first noun phrase of ``text``, after the word before it if any
+    (a compound such as "drink mat" may be a synonym as a whole).
+
+    The head is the last word before the first word that ends the phrase ("a frying pan" -> pan,
+    "a glass of wine" -> glass, "a tray to carry cups" -> tray); a participle after a noun ends it
+    too ("a board showing a code" -> board). A generic head or an amount defers to the phrase after
+    "of" ("a pair of headphones", "a pack of cards"); None when there is none ("the red one",
+    "something to write with").
+    """
+    phrase: list[str] = []
+    ws = [*words(text), ""]
+    for i, w in enumerate(ws):
+        named = [stem(x) for x in phrase if x not in STOP and not x.isdigit()]
+        participle = w.endswith("ing") and bool(named) and ws[i + 1] in DETERMINERS  # "showing a code"
+        if w and w not in PHRASE_END and not participle:
+            phrase.append(w)
+            continue
+        if named and named[-1] not in GENERIC_STEMS and named[-1] not in QUANTITY_STEMS:
+            return tuple(named[-2:])
+        if w != "of":
+            return None
+        phrase = []
+    return None
+
+
+def names_of(noun: tuple[str, ...]) -> set[str]:
+    """What a head noun (from :func:`head`) names: itself, its synonyms' canonical words, and those
+    of the compound it ends ("drink mat" -> coaster); never the modifier alone, nor themes."""
+    out = {noun[-1], *_SYN.get(noun[-1], ())}
+    if len(noun) > 1:
+        out.update(_SYN.get("_".join(noun), ()))
+    return out
 
 
 def content(text: str) -> list[str]:
