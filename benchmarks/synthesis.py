@@ -23,12 +23,16 @@ import numpy as np
 import vcage  # noqa: F401  (sets the GL backend before MuJoCo renders)
 from vcage.errors import VcageError
 from vcage.scene.compose import compose
-from vcage.scene.spec import ObjectSpec, SceneSpec
+from vcage.scene.spec import ObjectSpec, SceneSpec, TableSpec
 from vcage.synthesis.compositor import Compositor
-from vcage.synthesis.description import parse_description
+from vcage.synthesis.costs import Problem, Weights
+from vcage.synthesis.description import SceneDescription, parse_description
 from vcage.synthesis.driver import SynthesisConfig, synthesize
+from vcage.synthesis.errors import RefineRejected
+from vcage.synthesis.footprints import penetration
 from vcage.synthesis.matching import match
 from vcage.synthesis.perturb import PRESETS
+from vcage.synthesis.refine import RefineConfig, refine
 from vcage.synthesis.views import render_top
 
 PROMPTS = ["organize the breakfast table", "tidy the desk", "serve tea", "set the table", "display the fruit",
@@ -121,6 +125,65 @@ def end_to_end(lam: float = 1.0, seeds: int = 1, verbose: bool = True) -> dict[s
     return out
 
 
+SCALING_TYPES = ("block", "apple", "cup", "orange", "dice", "mug", "book", "phone", "banana", "can",
+                 "bowl", "sponge", "marker")
+
+
+def scaling_description(n: int) -> SceneDescription:
+    """``n`` catalog objects (cycling :data:`SCALING_TYPES`) and ``n - 1`` relations chaining them:
+    left_of, near and aligned in turn."""
+    objects = [{"name": f"o{i}", "type": SCALING_TYPES[i % len(SCALING_TYPES)]} for i in range(n)]
+    kinds = ("left_of", "near", "aligned")
+    relations = [{"kind": kinds[i % 3], "a": f"o{i}", "b": f"o{i + 1}"} for i in range(n - 1)]
+    return parse_description({"prompt": f"{n} objects", "text": "a chain", "objects": objects,
+                              "relations": relations})
+
+
+def scattered(problem: Problem, rng: np.random.Generator) -> dict[str, tuple[float, float, float]]:
+    """Poses of the problem's objects drawn one by one, uniformly on the table, until each is clear
+    of those before it (as an initial image shows them: no overlap, relations left to chance)."""
+    x0, y0, x1, y1 = problem.table
+    ps = np.zeros((len(problem.names), 3))
+    for k in range(len(ps)):
+        for _ in range(2000):
+            ps[k] = (rng.uniform(x0, x1), rng.uniform(y0, y1), rng.uniform(-math.pi, math.pi))
+            mine = problem.pairs[(problem.pairs.max(1) == k)]
+            if not len(mine) or penetration(ps, problem.half, mine).max() < -problem.margin:
+                break
+        else:
+            raise SystemExit(f"no room for object {k} of {len(ps)}")
+    return {n: (float(p[0]), float(p[1]), float(p[2])) for n, p in zip(problem.names, ps, strict=True)}
+
+
+def refine_scaling(sizes: list[int], seeds: int, lams: list[float]) -> None:
+    """The refine step alone on ``n``-object descriptions from starts scattered clear of each other
+    that violate the relations: accepted arrangements, seconds per scene (the rejected ones
+    included: they run every start), mean displacement from the start, per size and lambda."""
+    print(f"\nrefine alone: n objects scattered clear of each other on the table, relations left to chance, "
+          f"seeds 0..{seeds - 1}")
+    print(f"{'objects':>7s} {'lambda':>7s} {'accepted':>9s} {'s/scene':>8s} {'s max':>6s} {'displ mm':>9s}")
+    table = TableSpec()
+    for n in sizes:
+        desc = scaling_description(n)
+        for lam in lams:
+            ok, secs, moves = 0, [], []
+            for seed in range(seeds):
+                rng = np.random.default_rng(seed)
+                problem = Problem.build(desc, table)
+                start = scattered(problem, rng)
+                cfg = RefineConfig(weights=Weights(lam=lam))
+                t0 = time.perf_counter()
+                try:
+                    result = refine(problem, start, cfg, rng)
+                    ok += 1
+                    moves.append(result.displacement)
+                except RefineRejected:
+                    pass
+                secs.append(time.perf_counter() - t0)
+            displ = f"{1000 * np.mean(moves):9.1f}" if moves else f"{'n/a':>9s}"
+            print(f"{n:7d} {lam:7.2f} {ok:5d}/{seeds:<3d} {np.mean(secs):8.2f} {max(secs):6.2f} {displ}")
+
+
 def lambda_ablation(lams: list[float], seeds: int) -> None:
     print(f"\nrefine: lambda ablation (the same prompts, seeds 0..{seeds - 1})")
     print(f"{'lambda':>7s} {'valid':>7s} {'all held':>9s} {'rel held':>9s} {'displ mm':>9s} "
@@ -138,12 +201,17 @@ def main() -> None:
     parser.add_argument("--lambdas", type=str, default="", help="comma-separated lambdas to ablate, e.g. "
                         "0.1,1,10 (empty: no ablation)")
     parser.add_argument("--skip-matching", action="store_true")
+    parser.add_argument("--sizes", type=str, default="4,7,10,12", help="object counts of the refine-alone "
+                        "measurement (empty: skip it)")
     args = parser.parse_args()
     if not args.skip_matching:
         matching_sweep(args.seeds)
     end_to_end(1.0, args.scene_seeds)
-    if args.lambdas:
-        lambda_ablation([float(v) for v in args.lambdas.split(",")], args.scene_seeds)
+    lams = [float(v) for v in args.lambdas.split(",")] if args.lambdas else []
+    if lams:
+        lambda_ablation(lams, args.scene_seeds)
+    if args.sizes:
+        refine_scaling([int(v) for v in args.sizes.split(",")], 5, lams or [1.0])
 
 
 if __name__ == "__main__":

@@ -28,18 +28,23 @@ def corners(poses: np.ndarray, half: np.ndarray) -> np.ndarray:
 
 
 def penetration(poses: np.ndarray, half: np.ndarray, pairs: np.ndarray) -> np.ndarray:
-    """Penetration depth of each pair ``(i, j)`` of ``pairs`` (M, 2): (..., M)."""
+    """Penetration depth of each pair ``(i, j)`` of ``pairs`` (M, 2): (..., M). Along a test axis
+    ``u`` a rectangle spans its centre's projection plus or minus ``hx |x.u| + hy |y.u|``, so the
+    two overlap there by the sum of those radii minus the distance of the centres' projections."""
     if len(pairs) == 0:
         return np.zeros((*poses.shape[:-2], 0))
-    cs = corners(poses, half)
     ax = axes(poses)
     i, j = pairs[:, 0], pairs[:, 1]
-    test = np.concatenate([ax[..., i, :, :], ax[..., j, :, :]], axis=-2)  # (..., M, 4, 2)
-    pa = np.einsum("...mkd,...mcd->...mkc", test, cs[..., i, :, :])  # (..., M, 4 axes, 4 corners)
-    pb = np.einsum("...mkd,...mcd->...mkc", test, cs[..., j, :, :])
-    # how far to push along each axis to separate them, either way (also when one contains the other)
-    overlap = np.minimum(pa.max(-1) - pb.min(-1), pb.max(-1) - pa.min(-1))
-    return overlap.min(-1)
+    ai, aj = ax[..., i, :, :], ax[..., j, :, :]  # (..., M, 2, 2)
+    test = np.concatenate([ai, aj], axis=-2)  # (..., M, 4, 2): both rectangles' edge normals
+    d = poses[..., j, :2] - poses[..., i, :2]  # (..., M, 2)
+    apart = np.abs((test * d[..., None, :]).sum(-1))  # (..., M, 4)
+
+    def radius(own: np.ndarray, h: np.ndarray) -> np.ndarray:
+        along = np.abs((test[..., :, None, :] * own[..., None, :, :]).sum(-1))  # (..., M, 4, 2)
+        return (along * h[:, None, :]).sum(-1)
+
+    return (radius(ai, half[i]) + radius(aj, half[j]) - apart).min(-1)
 
 
 def to_local(point: np.ndarray, frame: np.ndarray) -> np.ndarray:
