@@ -161,12 +161,13 @@ def refine_scaling(sizes: list[int], seeds: int, lams: list[float]) -> None:
     included: they run every start), mean displacement from the start, per size and lambda."""
     print(f"\nrefine alone: n objects scattered clear of each other on the table, relations left to chance, "
           f"seeds 0..{seeds - 1}")
-    print(f"{'objects':>7s} {'lambda':>7s} {'accepted':>9s} {'s/scene':>8s} {'s max':>6s} {'displ mm':>9s}")
+    print(f"{'objects':>7s} {'lambda':>7s} {'accepted':>9s} {'s/scene':>8s} {'s max':>6s} "
+          f"{'s/accepted':>11s} {'displ mm':>9s}")
     table = TableSpec()
     for n in sizes:
         desc = scaling_description(n)
         for lam in lams:
-            ok, secs, moves = 0, [], []
+            ok, secs, moves, ok_secs = 0, [], [], []
             for seed in range(seeds):
                 rng = np.random.default_rng(seed)
                 problem = Problem.build(desc, table)
@@ -177,11 +178,14 @@ def refine_scaling(sizes: list[int], seeds: int, lams: list[float]) -> None:
                     result = refine(problem, start, cfg, rng)
                     ok += 1
                     moves.append(result.displacement)
+                    ok_secs.append(time.perf_counter() - t0)
                 except RefineRejected:
                     pass
                 secs.append(time.perf_counter() - t0)
             displ = f"{1000 * np.mean(moves):9.1f}" if moves else f"{'n/a':>9s}"
-            print(f"{n:7d} {lam:7.2f} {ok:5d}/{seeds:<3d} {np.mean(secs):8.2f} {max(secs):6.2f} {displ}")
+            per_ok = f"{np.mean(ok_secs):11.2f}" if ok_secs else f"{'n/a':>11s}"
+            print(f"{n:7d} {lam:7.2f} {ok:5d}/{seeds:<3d} {np.mean(secs):8.2f} {max(secs):6.2f} {per_ok} "
+                  f"{displ}")
 
 
 def lambda_ablation(lams: list[float], seeds: int) -> None:
@@ -201,6 +205,8 @@ def main() -> None:
     parser.add_argument("--lambdas", type=str, default="", help="comma-separated lambdas to ablate, e.g. "
                         "0.1,1,10 (empty: no ablation)")
     parser.add_argument("--skip-matching", action="store_true")
+    parser.add_argument("--refine-seeds", type=int, default=8, help="starts per size in the refine-alone "
+                        "measurement")
     parser.add_argument("--sizes", type=str, default="4,7,10,12", help="object counts of the refine-alone "
                         "measurement (empty: skip it)")
     args = parser.parse_args()
@@ -211,7 +217,7 @@ def main() -> None:
     if lams:
         lambda_ablation(lams, args.scene_seeds)
     if args.sizes:
-        refine_scaling([int(v) for v in args.sizes.split(",")], 5, lams or [1.0])
+        refine_scaling([int(v) for v in args.sizes.split(",")], args.refine_seeds, lams or [1.0])
 
 
 if __name__ == "__main__":
