@@ -5,13 +5,14 @@ of starts: the matched poses, the same with ordered objects put in order and eve
 moved onto its host, then seeded jitters of both. The first start whose result has no penetration
 (half the margin kept free), no
 footprint off the table or out of reach, and every relation within ``tolerance`` is accepted; after
-the last start a :class:`RefineRejected` names the worst violations of the best result. A descent
-stops before its last iteration once its arrangement is acceptable and the cost has stopped falling.
+the last start a :class:`RefineRejected` names the worst violations of the best result. Every
+descent runs all its iterations: Adam's steps do not shrink as the cost levels off, so stopping at
+the first acceptable arrangement leaves objects at the edge of their margins (measured: the mean
+displacement of the final refine from the matched poses doubled).
 """
 
 from __future__ import annotations
 
-import math
 import time
 from dataclasses import dataclass, field
 
@@ -22,8 +23,6 @@ from vcage.synthesis.errors import RefineRejected
 from vcage.synthesis.footprints import to_local, wrap
 
 Poses = dict[str, tuple[float, float, float]]
-CHECK_EVERY = 25  # iterations between checks of whether a descent may stop early
-SETTLED = 0.01  # ... once feasible and the last CHECK_EVERY steps cut the cost by less than this share
 
 
 @dataclass(frozen=True)
@@ -115,13 +114,7 @@ def descend(problem: Problem, start: np.ndarray, anchor: np.ndarray, cfg: Refine
     lr = np.tile([cfg.step, cfg.step, 5 * cfg.step], (n, 1))
     m, v = np.zeros_like(x), np.zeros_like(x)
     b1, b2 = 0.9, 0.999
-    settled_at = math.inf  # the cost when the arrangement was last checked
     for k in range(1, cfg.iterations + 1):
-        if k % CHECK_EVERY == 0:
-            cost = float(objective(problem, x[None], anchor, cfg.weights)[0])
-            if cost > (1 - SETTLED) * settled_at and accepted(problem, x, cfg.tolerance)[0]:
-                break  # feasible, and the last stretch of steps no longer paid
-            settled_at = cost
         costs = objective(problem, np.concatenate([x[None], x[None] + basis]), anchor, cfg.weights)
         g = ((costs[1:] - costs[0]) / eps).reshape(n, 3)
         if not np.any(g):
