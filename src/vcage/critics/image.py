@@ -14,7 +14,8 @@ space:
 - ``released(a)``: after the retreat, the robot does not touch ``a`` in every view that shows it
   (a projection overlap in one view is not contact); ``a`` hidden in every view is not released.
 - ``pressed(x)``: in the views at the subtask's deepest moment the robot touches ``x`` (front view,
-  at the same depth) and covers it (top view), and, where the top view has depth and ``x``'s type
+  at the same depth) and covers it (top view; with the top view's depth, at least
+  :data:`BUTTON_COVER` of its top, where the button is), and, where the top view has depth and ``x``'s type
   is known, the hand went deep enough: the orthographic top view's depth gives heights above the
   table, the robot's highest point over ``x``'s outline is the top of the wrist, :data:`HAND_TOP`
   above the hand's centre between the fingertips when the hand points down (as it does to press),
@@ -69,6 +70,10 @@ FINGER_CONTACT = 0.033  # metres
 # rest is the estimate's margin), a lever's stroke (its full close; the oracle asks for 0.15 of the
 # stapler's 0.25 rad, 0.6 of the stroke)
 PRESS_SHARE = {"button": 0.75, "lever": 0.5}
+# The hand pressing a button hides it from the top view: the object's top (its pixels within TOP_BAND
+# metres of its highest point, where the button or lever is) must be this much hidden by the robot
+TOP_BAND = 0.004
+BUTTON_COVER = 0.8
 
 
 class ImageCritic(Critic):
@@ -198,6 +203,9 @@ def _pressed(obs: Observation, x: str) -> tuple[bool, str]:
     outline = hull(mx_top) if mx_top.any() else mx_top
     if not np.any(dilate(top.segmentation == ROBOT, TOUCH) & outline):
         return False, f"the hand was not over {x}"
+    cover = _button_cover(obs, x)
+    if cover is not None and cover < BUTTON_COVER:
+        return False, f"the hand covered {cover:.0%} of {x}'s top (its button) at its lowest"
     short = _press_shortfall(obs, x)
     if short is not None and short > 0:
         return False, f"the hand stopped {1000 * short:.1f} mm short of pressing {x} down its travel"
@@ -216,6 +224,21 @@ def _heights(view: View) -> np.ndarray | None:
     if view.depth is None or view.pixel_size is None or not np.any(view.segmentation == -1):
         return None
     return float(np.median(view.depth[view.segmentation == -1])) - view.depth
+
+
+def _button_cover(obs: Observation, x: str) -> float | None:
+    """Share of ``x``'s top (its pixels within :data:`TOP_BAND` of its highest point before the
+    subtask, where a button or lever is) that the robot hides from the top view at the subtask's
+    lowest moment; None without the top view's depth."""
+    before, during = obs.before.get(TOP), obs.during.get(TOP)
+    hb = _heights(before) if before is not None else None
+    if hb is None or during is None:
+        return None
+    mask = _mask(obs, before, x)
+    if not mask.any():
+        return None
+    top = mask & (hb >= hb[mask].max() - TOP_BAND)
+    return float(((during.segmentation == ROBOT) & top).sum() / top.sum())
 
 
 def _press_shortfall(obs: Observation, x: str) -> float | None:
