@@ -140,13 +140,13 @@ def _job(job: tuple[str, int, int, str | None, str | None]) -> Sample | str:
     return out
 
 
-def jobs(goals: Iterable[str], seeds: int, faults_per_seed: int, cache: str | None
+def jobs(goals: Iterable[str], seeds: int, faults_per_seed: int, cache: str | None, first_seed: int = 0
          ) -> list[tuple[str, int, int, str | None, str | None]]:
     out: list[tuple[str, int, int, str | None, str | None]] = []
     for goal in goals:
         for i, sub in enumerate(_plan(goal).subtasks):
             names = faults_for(sub.skill)
-            for seed in range(seeds):
+            for seed in range(first_seed, first_seed + seeds):
                 out.append((goal, i, seed, None, cache))
                 for k in range(faults_per_seed if names else 0):  # rotate through the faults, seed by seed
                     out.append((goal, i, seed, names[(seed * faults_per_seed + k + i) % len(names)], cache))
@@ -199,14 +199,16 @@ def _no_top_depth(obs: Observation) -> Observation:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--seeds", type=int, default=2, help="scenes per subtask (seeds 0..N-1)")
+    parser.add_argument("--seeds", type=int, default=2, help="scenes per subtask (seeds K..K+N-1)")
+    parser.add_argument("--first-seed", type=int, default=0, help="K: the first seed (a later K gives a "
+                        "set disjoint from one a check was tuned on)")
     parser.add_argument("--faults-per-seed", type=int, default=2)
     parser.add_argument("--goals", nargs="*", default=list(DEFAULT_GOALS))
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--cache", default=None, help="directory for the samples' observations")
     parser.add_argument("--show-errors", action="store_true", help="print each misjudged sample")
     args = parser.parse_args()
-    todo = jobs(args.goals, args.seeds, args.faults_per_seed, args.cache)
+    todo = jobs(args.goals, args.seeds, args.faults_per_seed, args.cache, args.first_seed)
     t0 = time.perf_counter()
     with ProcessPoolExecutor(args.workers) as pool:
         results = list(pool.map(_job, todo))
@@ -219,7 +221,8 @@ def main() -> None:
     bare = sorted({sub.skill for g in args.goals for sub in _plan(g).subtasks if not faults_for(sub.skill)})
     if bare:
         print(f"no faults registered for skill(s) {', '.join(bare)}: their subtasks give successes only")
-    print(f"balanced set: goals {', '.join(args.goals)}; {args.seeds} seeds per subtask, as planned + "
+    print(f"balanced set: goals {', '.join(args.goals)}; {args.seeds} seeds per subtask (from seed "
+          f"{args.first_seed}), as planned + "
           f"{args.faults_per_seed} injected faults per seed; {len(todo)} rollouts, {len(samples)} samples "
           f"({sum(s.success for s in samples)} successes, {sum(not s.success for s in samples)} failures; "
           f"{sum(s.success for s in injected)} injected faults still succeeded), "
