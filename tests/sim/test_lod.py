@@ -108,9 +108,13 @@ def test_lod_changes_only_what_is_drawn(world: World) -> None:
     for name in ("nq", "nv", "nu", "nbody", "njnt", "ngeom", "nmesh", "nmeshvert", "nmeshface"):
         assert getattr(simple, name) == getattr(full, name), name
     for name in ("body_mass", "body_inertia", "body_pos", "body_quat", "jnt_range", "dof_damping",
-                 "geom_size", "geom_type", "geom_contype", "geom_conaffinity", "geom_pos", "geom_quat",
+                 "geom_type", "geom_contype", "geom_conaffinity", "geom_pos", "geom_quat",
                  "geom_dataid", "geom_group", "actuator_gainprm"):
         np.testing.assert_array_equal(getattr(simple, name), getattr(full, name), err_msg=name)
+    planes = full.geom_type == int(mujoco.mjtGeom.mjGEOM_PLANE)  # a plane's third size is its drawn grid
+    assert planes.any() and np.all(simple.geom_size[planes, 2] >= lod.PLANE_GRID)
+    np.testing.assert_array_equal(simple.geom_size[planes, :2], full.geom_size[planes, :2])
+    np.testing.assert_array_equal(simple.geom_size[~planes], full.geom_size[~planes])
     changed = np.nonzero(simple.mesh_facenum != full.mesh_facenum)[0]
     assert len(changed) >= 8
     mesh_geoms = full.geom_type == int(mujoco.mjtGeom.mjGEOM_MESH)

@@ -39,6 +39,10 @@ FACE_BUDGET = 1000  # faces per simplified mesh; see benchmarks/render_lod.py fo
 # much of a frame's geometry. Fewer quads would save more but change the shading of large faces
 # close to the wrist camera (benchmarks/render_lod.py: what it costs and what it changes).
 LOD_QUALITY = (16, 8, 4)
+# A plane is drawn as a grid of squares its third size sets (the floor: 0.1 m, so 60 x 60 squares and
+# as many triangles as the simplified robot); at this spacing its shading moves by under 0.1 level of
+# 255 on average (benchmarks/render_lod.py)
+PLANE_GRID = 0.3
 VERSION = 1  # bump when the simplification or the cache format changes
 
 
@@ -62,7 +66,8 @@ def lod_model(model: mujoco.MjModel, budget: int | None = None,
               quality: tuple[int, int, int] | None = LOD_QUALITY) -> mujoco.MjModel:
     """A copy of ``model`` whose heavy visual-only meshes are simplified to ``budget`` faces
     (None: :data:`FACE_BUDGET` as it is now) and whose primitives are drawn with ``quality``
-    (slices, stacks, quads; None: the model's own)."""
+    (slices, stacks, quads, and planes with grid squares of at least :data:`PLANE_GRID`; None: the
+    model's own)."""
     budget = FACE_BUDGET if budget is None else budget
     out = copy.copy(model)
     for mesh in heavy_visual_meshes(model, budget):
@@ -70,6 +75,8 @@ def lod_model(model: mujoco.MjModel, budget: int | None = None,
     if quality is not None:
         q = out.vis.quality
         q.numslices, q.numstacks, q.numquads = quality
+        planes = out.geom_type == int(mujoco.mjtGeom.mjGEOM_PLANE)
+        out.geom_size[planes, 2] = np.maximum(out.geom_size[planes, 2], PLANE_GRID)
     return out
 
 
