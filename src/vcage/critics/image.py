@@ -231,8 +231,10 @@ def _button_cover(obs: Observation, x: str) -> float | None:
     subtask, where a button or lever is) that the robot hides from the top view at the subtask's
     lowest moment; None without the top view's depth."""
     before, during = obs.before.get(TOP), obs.during.get(TOP)
-    hb = _heights(before) if before is not None else None
-    if hb is None or during is None:
+    if before is None or during is None:
+        return None
+    hb = _heights(before)
+    if hb is None:
         return None
     mask = _mask(obs, before, x)
     if not mask.any():
