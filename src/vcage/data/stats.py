@@ -25,13 +25,26 @@ def vector_stats(values: np.ndarray) -> Stats:
 
 
 def image_stats(frames: np.ndarray) -> Stats:
-    """Per-channel stats in [0, 1] of (T, H, W, 3) uint8 frames from a subsample; shapes (3, 1, 1)."""
+    """Per-channel stats in [0, 1] of (T, H, W, 3) uint8 frames from a subsample; shapes (3, 1, 1).
+
+    Computed from each channel's histogram of the 256 levels (the same values as over the pixels,
+    without turning a million pixels into floats: a tenth of the time per episode)."""
     t, h, w = frames.shape[:3]
     picks = np.unique(np.linspace(0, t - 1, min(t, IMAGE_SAMPLE_FRAMES)).round().astype(np.int64))
     stride = max(1, max(h, w) // IMAGE_SAMPLE_SIDE)
-    pixels = frames[picks, ::stride, ::stride].reshape(-1, 3).astype(np.float64) / 255.0
-    stats = vector_stats(pixels)
-    out = {name: stats[name].reshape(3, 1, 1) for name in ("min", "max", "mean", "std")}
+    sample = np.asarray(frames[picks, ::stride, ::stride])
+    if sample.dtype != np.uint8:
+        raise ValueError(f"video frames must be uint8, got {sample.dtype}")
+    counts = np.stack([np.bincount(sample[..., c].ravel(), minlength=256) for c in range(3)])
+    counts = counts.astype(np.float64)
+    levels = np.arange(256) / 255.0
+    n = counts.sum(1)
+    mean = counts @ levels / n
+    std = np.sqrt((counts * (levels[None, :] - mean[:, None]) ** 2).sum(1) / n)
+    present = counts > 0
+    lo = levels[np.argmax(present, axis=1)]
+    hi = levels[255 - np.argmax(present[:, ::-1], axis=1)]
+    out = {name: v.reshape(3, 1, 1) for name, v in (("min", lo), ("max", hi), ("mean", mean), ("std", std))}
     out["count"] = np.array([len(picks)], dtype=np.int64)
     return out
 
