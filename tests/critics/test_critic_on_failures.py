@@ -106,6 +106,15 @@ def test_an_injected_silent_failure_is_rejected_by_its_check(scenario: str, faul
     assert predicate in verdict.reason
 
 
+def test_a_press_is_judged_at_its_own_lowest_moment() -> None:
+    """A sweep after the press (knocking nothing over here) takes the hand lower than the press did;
+    the views "during" the subtask are still those of the press, which the critic accepts."""
+    result = _run("pressed", "knock_over", 1)
+    assert result.applied and result.success, result.outcome.oracle
+    verdict = CRITIC.judge(result.obs)
+    assert verdict.accept, verdict.reason
+
+
 def test_the_checks_under_test_cover_every_image_check() -> None:
     from vcage.critics.image import IMAGE_CHECKS
 

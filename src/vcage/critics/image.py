@@ -3,8 +3,8 @@
 It sees what :mod:`vcage.pipeline.verifier` renders around the subtask: the orthographic top view
 (RGB and the renderer's segmentation masks, with its pixel size in metres) and the perspective front
 view (RGB, segmentation and depth), before the subtask, at its deepest moment (where the hand was
-lowest) and after the retreat. It never reads simulator state. Each predicate is checked in image
-space:
+lowest in the subtask's own motion, not in what ran after it) and after the retreat. It never reads
+simulator state. Each predicate is checked in image space:
 
 - ``on(a, b)`` / ``inside(a, b)``: in the top view most of ``a``'s pixels lie in the convex hull of
   ``b``'s outline (or, when ``a`` is the larger, ``b``'s in ``a``'s) and ``a``'s centre lies over

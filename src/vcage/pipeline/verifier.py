@@ -69,4 +69,5 @@ class Verifier:
 
     def _deepest(self, outcome: Outcome) -> dict[str, View]:
         """Views of the recorded frame where the hand was lowest during the subtask."""
-        return deepest(self.world, self.renderer, self.recording, outcome.start, outcome.end)
+        return deepest(self.world, self.renderer, self.recording, outcome.start, outcome.end,
+                       self.plan.subtasks[outcome.index].skill)

@@ -1,14 +1,13 @@
 """The critic's part of a trial: the views before, during and after the subtask, and its verdict.
 
 The same views the pipeline's verifier gives a critic (``pipeline.verifier``: top and front RGB
-with segmentation, depth for the front camera; the "during" frame where the hand was lowest), built
-here because this layer sits below the pipeline. The critic sees views and the subtask's text and
-predicates, never the simulator; the oracle's values ride along for the oracle critic only.
+with segmentation and depth; the "during" frame where the hand was lowest in the subtask's own
+skill), built here because this layer sits below the pipeline. The critic sees views and the
+subtask's text and predicates, never the simulator; the oracle's values ride along for the oracle
+critic only.
 """
 
 from __future__ import annotations
-
-import numpy as np
 
 from vcage.critics.base import Critic, Observation, Verdict, View
 from vcage.planning.schema import Subtask
@@ -32,11 +31,17 @@ def views(renderer: Renderer | None) -> dict[str, View]:
     return render_views(renderer) if renderer is not None else {}
 
 
-def deepest(world: World, renderer: Renderer | None, rec: Recording, start: int, end: int) -> dict[str, View]:
-    """Views of the recorded frame in ``[start, end)`` where the hand was lowest (e.g. a press)."""
+def deepest(world: World, renderer: Renderer | None, rec: Recording, start: int, end: int,
+            skill: str | None = None) -> dict[str, View]:
+    """Views of the recorded frame in ``[start, end)`` where the hand was lowest (e.g. a press):
+    within the motions of ``skill`` (the subtask's own, as the recording names what ran) when the
+    recording holds any there, else over the whole range. What ran after the subtask's own motion
+    (a retreat, or a sweep that knocked something over) may go lower without hiding its moment."""
     if renderer is None or end <= start or not rec.states:
         return {}
-    frame = start + int(np.argmin([p[2] for p in rec.ee_pos[start:end]]))
+    frames = [i for name, a, b in rec.skills if skill is not None and name == skill
+              for i in range(max(a, start), min(b, end))] or list(range(start, end))
+    frame = min(frames, key=lambda i: rec.ee_pos[i][2])  # the first of equal lows, as argmin
     now = world.get_state()
     world.set_state(rec.states[frame])
     try:

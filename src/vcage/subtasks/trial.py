@@ -201,9 +201,9 @@ def _execute(cand: Candidate, calls: list[SkillCall], world: World, critic: Crit
         return "oracle", "predicates do not hold: " + ", ".join(k for k, v in holds.items() if not v)
     if critic is None:
         return None, "oracle predicates held"
-    verdict = judge.judge(critic, cand.subtask(), world, before,
-                          judge.deepest(world, renderer, skills.player.recording, 0, end),
-                          judge.views(renderer), holds)
+    subtask = cand.subtask()
+    during = judge.deepest(world, renderer, skills.player.recording, 0, end, subtask.skill)
+    verdict = judge.judge(critic, subtask, world, before, during, judge.views(renderer), holds)
     if not verdict.accept:
         return "critic", verdict.reason
     return None, verdict.reason
