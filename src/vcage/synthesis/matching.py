@@ -342,7 +342,15 @@ def match(init: TopView, empty: np.ndarray, goal: np.ndarray,
     for t in templates:
         groups.setdefault(t.look, []).append(t)
     assigned = _assign(groups, cands)
-    agrees = {t.name: _inliers(t, scene, *_fine(t, scene, *assigned[t.name][1:])[1:]) >= MIN_INLIERS
+    refined: dict[tuple[str, Candidate], tuple[Candidate, float]] = {}  # (name, coarse) -> fine, inliers
+
+    def refine_at(t: _Template, c: Candidate) -> tuple[Candidate, float]:
+        if (t.name, c) not in refined:
+            fine = _fine(t, scene, *c[1:])
+            refined[t.name, c] = fine, _inliers(t, scene, *fine[1:])
+        return refined[t.name, c]
+
+    agrees = {t.name: refine_at(t, assigned[t.name])[1] >= MIN_INLIERS
               for t in templates if t.name in assigned}
     chosen = _exclusive(templates, assigned, cands, stacked or set(), agrees)
     matches: dict[str, Match] = {}
@@ -352,9 +360,7 @@ def match(init: TopView, empty: np.ndarray, goal: np.ndarray,
         if found_t is None or name not in chosen:
             matches[name] = Match(name, False, (x0, y0), yaw0, (math.nan, math.nan), math.inf, 0.0)
             continue
-        _, u, v, a = chosen[name]
-        err, u, v, a = _fine(found_t, scene, u, v, a)
-        inl = _inliers(found_t, scene, u, v, a)
+        (err, u, v, a), inl = refine_at(found_t, chosen[name])
         xy = init.camera.to_world(np.array([[u, v]]), init.heights[name])[0]
         yaw = float((yaw0 + math.radians(a) * init.camera.handedness() + math.pi) % (2 * math.pi) - math.pi)
         found = inl >= MIN_INLIERS

@@ -1,6 +1,6 @@
 """The refine agent: ``P* = argmin L_collision(P) + lambda * L_semantic(P, D_scene)``.
 
-Gradient descent (Adam, central-difference gradients evaluated as one batch) from a bounded number
+Gradient descent (Adam, forward-difference gradients evaluated as one batch) from a bounded number
 of starts: the matched poses, the same with ordered objects put in order and every supported object
 moved onto its host, then seeded jitters of both. The first start whose result has no penetration
 (half the margin kept free), no
@@ -33,7 +33,7 @@ class RefineConfig:
     step: float = 0.004  # metres per Adam step at the start (yaw: x5 rad)
     jitter: float = 0.04  # metres of the seeded restarts' jitter
     tolerance: float = 0.002  # metres of violation accepted
-    epsilon: float = 1e-4  # central-difference step
+    epsilon: float = 1e-4  # forward-difference step
 
 
 @dataclass(frozen=True)
