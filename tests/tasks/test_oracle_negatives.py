@@ -7,6 +7,8 @@ skills), never a flag set by hand.
 
 from __future__ import annotations
 
+import numpy as np
+
 from vcage.planning.schema import Predicate
 from vcage.scene.compose import compose
 from vcage.scene.spec import ObjectSpec, SceneSpec
@@ -74,6 +76,24 @@ def test_inside_needs_the_region_and_the_height_below_the_rim() -> None:
                                        ObjectSpec("basket", "basket", (0.5, 0.1))))).make_world()
     above.forward()  # held over the basket, in its region but above the rim
     assert not _value(above, "inside", "bread", "basket")
+
+
+def test_on_a_tipped_block_is_not_beside_it() -> None:
+    """A block knocked onto its side has its placement frame beside it: a block lying there is not on
+    it (seen in a Vanilla rollout, where the oracle called two blocks side by side a tower)."""
+    world = compose(SceneSpec(objects=(ObjectSpec("base", "block", (0.55, 0.0)),
+                                       ObjectSpec("middle", "block", (0.55, 0.1))))).make_world()
+    half, turn = 0.0225, [np.cos(-np.pi / 4), np.sin(-np.pi / 4), 0.0, 0.0]  # 90 degrees about x
+    for name, y in (("base", -half), ("middle", half + 0.002)):  # both on their sides, side by side
+        adr = int(world.model.jnt_qposadr[world.model.joint(f"{name}/free").id])
+        world.data.qpos[adr:adr + 7] = [0.55, y, world.table_top() + half, *turn]
+    world.forward()
+    world.settle(0.5)
+    assert all(abs(world.object_mat(n)[2, 2]) < 0.1 for n in ("base", "middle"))  # on their sides
+    assert not _value(world, "on", "middle", "base")
+    tower = _settled(ObjectSpec("base", "block", (0.55, 0.0)),
+                     ObjectSpec("middle", "block", (0.55, 0.0), z=0.79))
+    assert _value(tower, "on", "middle", "base")
 
 
 def test_released_is_false_while_the_hand_holds_the_object() -> None:

@@ -19,6 +19,7 @@ from vcage.sim.world import World
 
 XY_TOL = 0.01  # slack beyond a placement region's edge
 Z_TOL = 0.02  # how far above a surface an object may rest and still be "on" it
+SURFACE_TILT = np.pi / 4  # radians a placement surface may tilt and still hold what rests on it
 
 
 def _region(world: World, target: str,
@@ -49,17 +50,24 @@ def contact_between(world: World, a: str, b: str) -> bool:
 
 
 def on(world: World, obj: str, target: str, placement: str | None = None) -> bool:
-    """``obj`` rests on ``target``'s placement surface, within its region."""
+    """``obj`` rests on ``target``'s placement surface, within its region; the surface faces up
+    (a target tipped over has no placement surface to rest on: the region's frame would lie beside
+    it, where an object standing next to a tipped block would count as on it)."""
     center, rot, half, _ = _region(world, target, placement)
     dz = world.object_pos(obj)[2] - center[2]
-    return -0.01 <= dz <= Z_TOL and _in_region(world, obj, center, rot, half)
+    return _faces_up(rot) and -0.01 <= dz <= Z_TOL and _in_region(world, obj, center, rot, half)
 
 
 def inside(world: World, obj: str, container: str, placement: str | None = None) -> bool:
-    """``obj``'s origin is within the container's region and below its rim."""
+    """``obj``'s origin is within the container's region and below its rim; the container's opening
+    faces up."""
     center, rot, half, wall = _region(world, container, placement)
     dz = world.object_pos(obj)[2] - center[2]
-    return -0.01 <= dz <= max(wall, Z_TOL) and _in_region(world, obj, center, rot, half)
+    return _faces_up(rot) and -0.01 <= dz <= max(wall, Z_TOL) and _in_region(world, obj, center, rot, half)
+
+
+def _faces_up(rot: np.ndarray) -> bool:
+    return tilt_of(rot) <= SURFACE_TILT
 
 
 def on_table(world: World, obj: str, tol: float = 0.01) -> bool:
