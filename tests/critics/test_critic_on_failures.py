@@ -37,6 +37,9 @@ ROW_RIGHT = (O("a", "block", (0.5, 0.1)), O("b", "block", (0.55, -0.05)))
 
 SCENARIOS: dict[str, tuple[tuple[O, ...], Subtask]] = {
     "on": (BLOCK_PAD, put_on("block", "pad", "the block is on the pad")),
+    # the pad under the hand's home: a mouse never let go is carried back over it
+    "on_home": ((O("mouse", "mouse", (0.55, -0.12)), O("pad", "mouse_pad", (0.45, 0.0))),
+                put_on("mouse", "pad", "the mouse is on the pad")),
     "inside": (BREAD_BASKET, put_in("bread", "basket", "the bread is in the basket")),
     "pressed": (BELL, press("bell", "the bell is rung")),
     "upright": (CLOCK, press("clock", "the clock's button is pressed")),
@@ -61,6 +64,7 @@ FAILURES = [
     ("inside", "off_target", 1, "inside(bread, basket)"),
     ("inside", "on_edge", 0, "inside(bread, basket)"),
     ("on", "no_release", 0, "released(block)"),
+    ("on_home", "no_release", 0, "on(mouse, pad)"),  # held over the pad, higher than resting on it allows
     ("inside", "no_release", 0, "released(bread)"),  # the bread in the hand shows from the top
     ("pressed", "press_hover", 0, "pressed(bell)"),
     ("pressed", "press_miss", 0, "pressed(bell)"),
@@ -104,6 +108,18 @@ def test_an_injected_silent_failure_is_rejected_by_its_check(scenario: str, faul
     assert not verdict.accept
     assert verdict.details["checks"][predicate] is False, verdict.reason
     assert predicate in verdict.reason
+
+
+def test_an_object_put_down_on_clutter_that_lies_on_its_target_is_not_on_it() -> None:
+    """A block lies on the pad; the mouse put on the pad comes to rest on the block. From the top the
+    mouse lies over the pad as it would on it; what the top view showed before (the block, 4.5 cm
+    high, where the mouse is now) says it cannot be down on the pad."""
+    objects = (*MOUSE_PAD, O("block", "block", (0.55, 0.12), z=0.8))
+    result = run(objects, put_on("mouse", "pad", "the mouse is on the pad"))
+    assert result.outcome.oracle == {"on(mouse, pad)": False, "released(mouse)": True}
+    verdict = CRITIC.judge(result.obs)
+    assert not verdict.accept
+    assert "mouse lies over block" in verdict.reason
 
 
 def test_a_press_is_judged_at_its_own_lowest_moment() -> None:
