@@ -15,6 +15,8 @@ whose denominator is empty prints "n/a" (not 0%).
 
     LP_NUM_THREADS=1 .venv/bin/python benchmarks/critic_agreement.py --seeds 10 --workers 2
 
+``--first-seed K`` starts at episode K, for a sample that no threshold was chosen on.
+
 ``--mesh-detail full`` renders the critic's views with the robot's meshes as shipped (the default
 is the simplified meshes, as in a run).
 """
@@ -92,19 +94,22 @@ def _line(name: str, pairs: list[Row]) -> str:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--seeds", type=int, default=10, help="Vanilla rollouts per goal (episodes 0..N-1)")
+    parser.add_argument("--seeds", type=int, default=10, help="Vanilla rollouts per goal (episodes K..K+N-1)")
+    parser.add_argument("--first-seed", type=int, default=0, help="K: the first episode (a later K gives "
+                        "rollouts no check was tuned on)")
     parser.add_argument("--goals", nargs="*", default=list(DEFAULT_GOALS))
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--mesh-detail", choices=MESH_DETAILS, default=RenderConfig().mesh_detail,
                         help="how the critic's views draw the robot's meshes")
     parser.add_argument("--show-errors", action="store_true", help="print each disagreement")
     args = parser.parse_args()
-    jobs = [(g, s, args.mesh_detail) for g in args.goals for s in range(args.seeds)]
+    seeds = range(args.first_seed, args.first_seed + args.seeds)
+    jobs = [(g, s, args.mesh_detail) for g in args.goals for s in seeds]
     t0 = time.perf_counter()
     with ProcessPoolExecutor(args.workers) as pool:
         pairs = [p for rows in pool.map(_run, jobs) for p in rows]
     print(f"image critic vs oracle on Vanilla rollouts (naive placement, no scene check), "
-          f"{args.seeds} seeds per goal, every subtask judged, mesh detail {args.mesh_detail}; "
+          f"{args.seeds} seeds per goal (from {args.first_seed}), every subtask judged, mesh detail {args.mesh_detail}; "
           f"{time.perf_counter() - t0:.0f} s wall\n")
     print(f"{'goal':24s} {'judged':>6s} {'succ':>5s} {'fail':>5s} {'scenes':>6s} {'agree':>7s} {'prec':>7s} "
           f"{'recall':>7s} {'caught':>9s} {'bal.acc':>8s}")
