@@ -109,7 +109,8 @@ def main() -> None:
     with ProcessPoolExecutor(args.workers) as pool:
         pairs = [p for rows in pool.map(_run, jobs) for p in rows]
     print(f"image critic vs oracle on Vanilla rollouts (naive placement, no scene check), "
-          f"{args.seeds} seeds per goal (from {args.first_seed}), every subtask judged, mesh detail {args.mesh_detail}; "
+          f"{args.seeds} seeds per goal (from {args.first_seed}), every subtask judged, "
+          f"mesh detail {args.mesh_detail}; "
           f"{time.perf_counter() - t0:.0f} s wall\n")
     print(f"{'goal':24s} {'judged':>6s} {'succ':>5s} {'fail':>5s} {'scenes':>6s} {'agree':>7s} {'prec':>7s} "
           f"{'recall':>7s} {'caught':>9s} {'bal.acc':>8s}")
