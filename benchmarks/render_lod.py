@@ -15,8 +15,10 @@ posture at 128x128 and 320x240 with full and LOD meshes. Printed per camera and 
 - obj IoU: the same pooled IoU for the objects' pixels (each object's label against its own);
 - MAD: mean absolute RGB difference (0-255) over all pixels; ``px>16``: share of pixels where a
   channel differs by more than 16;
-- ms per frame (update + render + read) with full and LOD meshes, the best of ``--rounds``
-  interleaved rounds measured in the same run, and their ratio.
+- ms per frame (update + render + read) with full meshes, LOD meshes, and LOD meshes with the
+  geoms batched per body and look (``vcage.sim.batching``, what a run draws), the best of
+  ``--rounds`` interleaved rounds measured in the same run, and the ratios full / batched and
+  LOD / batched. The IoU and difference columns compare full with batched.
 
 Then the faces drawn, and the video pass of the recording's first ``--video-frames`` states with
 the two default cameras: before (``set_state`` with ``mj_forward`` per frame, a render per camera,
@@ -42,7 +44,7 @@ from vcage.config import CAMERAS, RenderConfig
 from vcage.pipeline.config import GenerateConfig
 from vcage.pipeline.episode import Attempt, attempt
 from vcage.planning import make_planner
-from vcage.sim import lod
+from vcage.sim import batching, lod
 from vcage.sim.render import ROBOT, Renderer
 from vcage.sim.robot import GRIPPER_OPEN, HOME_QPOS
 from vcage.sim.world import World
@@ -80,7 +82,7 @@ def postures(world: World, n: int, seed: int) -> list[np.ndarray]:
 
 
 def compare(world: World, states: list[np.ndarray], camera: str, full: Renderer, simple: Renderer,
-            rounds: int) -> str:
+            unbatched: Renderer, rounds: int) -> str:
     inter = union_all = obj_inter = obj_union = 0
     ious, mads, changed = [], [], []
     for state in states:
@@ -96,9 +98,9 @@ def compare(world: World, states: list[np.ndarray], camera: str, full: Renderer,
         oa, ob = full.segmentation(camera), simple.segmentation(camera)
         objects = (oa >= 0) | (ob >= 0)
         obj_inter, obj_union = obj_inter + ((oa == ob) & objects).sum(), obj_union + objects.sum()
-    ms = {"full": np.inf, "lod": np.inf}
-    for _ in range(rounds):  # interleaved, so that both see the same load
-        for name, renderer in (("full", full), ("lod", simple)):
+    ms = {"full": np.inf, "unbatched": np.inf, "lod": np.inf}
+    for _ in range(rounds):  # interleaved, so that all see the same load
+        for name, renderer in (("full", full), ("unbatched", unbatched), ("lod", simple)):
             spent = 0.0
             for state in states:
                 world.show_state(state)
@@ -110,7 +112,8 @@ def compare(world: World, states: list[np.ndarray], camera: str, full: Renderer,
     iou = f"{pooled} {np.min(ious):7.4f}" if ious else f"{pooled} {'n/a':>7s}"
     obj = f"{obj_inter / obj_union:8.4f}" if obj_union else f"{'n/a':>8s}"
     return (f"{iou} {len(ious):4d} {obj} {np.mean(mads):6.2f} {np.mean(changed):7.2%} "
-            f"{ms['full']:8.2f} {ms['lod']:8.2f} {ms['full'] / ms['lod']:6.2f}x")
+            f"{ms['full']:8.2f} {ms['unbatched']:8.2f} {ms['lod']:8.2f} {ms['full'] / ms['lod']:6.2f}x "
+            f"{ms['unbatched'] / ms['lod']:6.2f}x")
 
 
 def video_pass(world: World, states: np.ndarray, cameras: tuple[str, ...], size: tuple[int, int],
@@ -127,8 +130,8 @@ def video_pass(world: World, states: np.ndarray, cameras: tuple[str, ...], size:
                     out[cam][i] = r.rgb(cam)
             return time.perf_counter() - t0
 
-    def after() -> float:
-        with Renderer(world, width, height, "lod") as r:
+    def after(batch: bool = True) -> float:
+        with Renderer(world, width, height, "lod", batch=batch) as r:
             t0 = time.perf_counter()
             r.rgb_states(states, cameras)
             return time.perf_counter() - t0
@@ -143,16 +146,18 @@ def video_pass(world: World, states: np.ndarray, cameras: tuple[str, ...], size:
         world.show_state(state)
     show = time.perf_counter() - t0
     world.set_state(current)
-    full = lod_loop = new = np.inf
+    full = lod_loop = unbatched = new = np.inf
     for _ in range(rounds):  # interleaved; the best of each
-        full, lod_loop, new = min(full, before("full")), min(lod_loop, before("lod")), min(new, after())
+        full, lod_loop = min(full, before("full")), min(lod_loop, before("lod"))
+        unbatched, new = min(unbatched, after(batch=False)), min(new, after())
     n = len(states)
     print(f"\nvideo pass: {n} recorded states x {len(cameras)} cameras ({', '.join(cameras)}) at "
           f"{width}x{height}, ms per state (all cameras)")
     print(f"  before  set_state (mj_forward) + render per camera, full meshes  {full / n * 1e3:7.2f}")
     print(f"          the same loop with LOD meshes                           {lod_loop / n * 1e3:7.2f}")
-    print(f"  after   Renderer.rgb_states (show_state: kinematics only), LOD   {new / n * 1e3:7.2f}"
-          f"   ({full / new:.2f}x faster than before)")
+    print(f"  after   Renderer.rgb_states (show_state: kinematics only), LOD   {unbatched / n * 1e3:7.2f}")
+    print(f"          the same, geoms batched per body and look                {new / n * 1e3:7.2f}"
+          f"   ({full / new:.2f}x faster than before, {unbatched / new:.2f}x than unbatched)")
     print(f"  restoring a state: set_state {forward / n * 1e3:.3f} ms, show_state {show / n * 1e3:.3f} ms")
 
 
@@ -181,7 +186,12 @@ def main() -> None:
     heavy = lod.heavy_visual_meshes(world.model, args.budget)
     full_faces, simple_faces = world.model.mesh_facenum, simple_model.mesh_facenum
     print(f"faces: scene {int(full_faces.sum()):,} -> {int(simple_faces.sum()):,}; the {len(heavy)} "
-          f"simplified meshes {int(full_faces[heavy].sum()):,} -> {int(simple_faces[heavy].sum()):,}\n")
+          f"simplified meshes {int(full_faces[heavy].sum()):,} -> {int(simple_faces[heavy].sum()):,}")
+    t0 = time.perf_counter()
+    batched_model = batching.batched_model(simple_model, world.spec)[0]
+    drawn = [int(np.isin(m.geom_group, batching.DRAWN_GROUPS).sum()) for m in (simple_model, batched_model)]
+    print(f"geoms drawn: {drawn[0]} -> {drawn[1]} batched per body and look (compiled in "
+          f"{time.perf_counter() - t0:.2f} s)\n")
 
     states = postures(world, args.postures, args.seed)
     q = world.model.vis.quality
@@ -189,17 +199,19 @@ def main() -> None:
           f"LOD {lod.LOD_QUALITY}\n")
     header = (f"{'camera':12s} {'size':>7s} {'IoU':>8s} {'min':>7s} {'vis':>4s} {'obj IoU':>8s} "
               f"{'MAD':>6s} "
-              f"{'px>16':>7s} {'full ms':>8s} {'LOD ms':>8s} {'ratio':>7s}")
+              f"{'px>16':>7s} {'full ms':>8s} {'LOD ms':>8s} {'batched':>8s} {'ratio':>7s} {'batch':>7s}")
     print(header)
     for width, height in SIZES:
         full, simple = Renderer(world, width, height, "full"), Renderer(world, width, height, "lod")
+        unbatched = Renderer(world, width, height, "lod", batch=False)
         try:
             for camera in CAMERAS:
                 print(f"{camera:12s} {f'{width}x{height}':>7s} "
-                      + compare(world, states, camera, full, simple, args.rounds))
+                      + compare(world, states, camera, full, simple, unbatched, args.rounds))
         finally:
             full.close()
             simple.close()
+            unbatched.close()
     recording = np.asarray(result.recording.states)[: args.video_frames]
     video_pass(world, recording, RenderConfig().cameras, RenderConfig().size, args.rounds)
 

@@ -37,9 +37,10 @@ class ComposedScene:
     model: mujoco.MjModel
     objects: dict[str, ObjectInstance]
     spec: SceneSpec
+    mjspec: mujoco.MjSpec | None = None  # what ``model`` was compiled from
 
     def make_world(self, sim: SimConfig = SimConfig()) -> World:
-        return World(self.model, self.objects, sim)
+        return World(self.model, self.objects, sim, self.mjspec)
 
 
 def _base_spec(sim: SimConfig) -> mujoco.MjSpec:
@@ -157,7 +158,7 @@ def compose(scene: SceneSpec, sim: SimConfig = SimConfig()) -> ComposedScene:
                                o.color or next(iter(types[o.name].colors)))
         for o in scene.objects
     }
-    composed = ComposedScene(model, objects, scene)
+    composed = ComposedScene(model, objects, scene, spec)
     _MODEL_CACHE[key] = composed
     if len(_MODEL_CACHE) > _CACHE_SIZE:
         _MODEL_CACHE.popitem(last=False)

@@ -63,14 +63,16 @@ def render_model(model: mujoco.MjModel, mesh_detail: str) -> mujoco.MjModel:
 
 
 def lod_model(model: mujoco.MjModel, budget: int | None = None,
-              quality: tuple[int, int, int] | None = LOD_QUALITY) -> mujoco.MjModel:
+              quality: tuple[int, int, int] | None = LOD_QUALITY, keep: str | None = None) -> mujoco.MjModel:
     """A copy of ``model`` whose heavy visual-only meshes are simplified to ``budget`` faces
     (None: :data:`FACE_BUDGET` as it is now) and whose primitives are drawn with ``quality``
     (slices, stacks, quads, and planes with grid squares of at least :data:`PLANE_GRID`; None: the
-    model's own)."""
+    model's own). Meshes whose names start with ``keep`` are left as they are."""
     budget = FACE_BUDGET if budget is None else budget
     out = copy.copy(model)
     for mesh in heavy_visual_meshes(model, budget):
+        if keep is not None and model.mesh(mesh).name.startswith(keep):
+            continue
         _write_mesh(out, mesh, simplified(*mesh_arrays(model, mesh), budget))
     if quality is not None:
         q = out.vis.quality

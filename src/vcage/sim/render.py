@@ -17,6 +17,7 @@ import mujoco
 import numpy as np
 
 from vcage.errors import ConfigError
+from vcage.sim.batching import batched
 from vcage.sim.lod import render_model
 from vcage.sim.world import World
 
@@ -35,10 +36,13 @@ class Renderer:
     """Renders a :class:`World` at a fixed resolution; dataset quality (no shadows) by default.
 
     ``mesh_detail`` (see :data:`vcage.config.MESH_DETAILS`) picks the model drawn: the world's own,
-    or a copy with simplified visual meshes that draws the world's data.
+    or a copy with simplified visual meshes that draws the world's data; with ``batch`` (and a world
+    that knows its ``MjSpec``) that copy's geoms are merged per body and look
+    (:mod:`vcage.sim.batching`: the same pixels with fewer draw calls).
     """
 
-    def __init__(self, world: World, width: int = 320, height: int = 240, mesh_detail: str = "lod") -> None:
+    def __init__(self, world: World, width: int = 320, height: int = 240, mesh_detail: str = "lod",
+                 batch: bool = True) -> None:
         model = world.model
         if width > model.vis.global_.offwidth or height > model.vis.global_.offheight:
             raise ConfigError(
@@ -47,7 +51,16 @@ class Renderer:
             )
         self.world = world
         self.width, self.height = width, height
-        self.model = render_model(model, mesh_detail)  # what is drawn; never stepped
+        # What is drawn (never stepped), the geom of the world's model each drawn geom stands for
+        # (segmentation), and the data drawn: the world's own, or for a batched model (geoms of its
+        # own) its own data, set to the world's poses before each frame
+        self._source: np.ndarray | None = None
+        self._data = world.data
+        if mesh_detail == "lod" and batch and world.spec is not None:
+            self.model, self._source = batched(model, world.spec)
+            self._data = mujoco.MjData(self.model)
+        else:
+            self.model = render_model(model, mesh_detail)
         self._renderer: mujoco.Renderer | None = mujoco.Renderer(self.model, height, width)
         self._cameras = {model.camera(i).name for i in range(model.ncam)}
 
@@ -57,6 +70,17 @@ class Renderer:
         if camera not in self._cameras:
             raise ConfigError(f"unknown camera {camera!r}; cameras: {sorted(self._cameras)}")
         return self._renderer
+
+    def _drawn(self) -> mujoco.MjData:
+        """The data to draw: the world's, or the batched model's set to the world's poses."""
+        data, world = self._data, self.world.data
+        if data is not world:
+            data.qpos[:] = world.qpos
+            data.mocap_pos[:] = world.mocap_pos
+            data.mocap_quat[:] = world.mocap_quat
+            mujoco.mj_kinematics(self.model, data)
+            mujoco.mj_camlight(self.model, data)
+        return data
 
     def _orthographic(self, camera: str) -> bool:
         self._check(camera)
@@ -69,14 +93,14 @@ class Renderer:
         r = self._check(camera)
         getattr(r, f"enable_{mode}_rendering")()
         try:
-            r.update_scene(self.world.data, camera=camera)
+            r.update_scene(self._drawn(), camera=camera)
             return r.render()
         finally:
             getattr(r, f"disable_{mode}_rendering")()
 
     def rgb(self, camera: str) -> np.ndarray:
         r = self._check(camera)
-        r.update_scene(self.world.data, camera=camera)
+        r.update_scene(self._drawn(), camera=camera)
         return r.render()
 
     def depth(self, camera: str) -> np.ndarray:
@@ -99,9 +123,10 @@ class Renderer:
         ids, types = seg[..., 0], seg[..., 1]
         out = np.full(ids.shape, -1, dtype=np.int32)
         is_geom = (types == int(mujoco.mjtObj.mjOBJ_GEOM)) & (ids >= 0)
-        out[is_geom] = self.world.object_of_geom(ids[is_geom])
+        geoms = ids[is_geom] if self._source is None else self._source[ids[is_geom]]
+        out[is_geom] = self.world.object_of_geom(geoms)
         robot = np.zeros_like(is_geom)
-        robot[is_geom] = self.world.geom_is_robot(ids[is_geom])
+        robot[is_geom] = self.world.geom_is_robot(geoms)
         out[robot] = ROBOT
         return out
 
@@ -118,8 +143,9 @@ class Renderer:
         try:
             for i, state in enumerate(states):
                 self.world.show_state(state)
+                data = self._drawn()
                 for camera in cameras:
-                    renderer.update_scene(self.world.data, camera=camera)
+                    renderer.update_scene(data, camera=camera)
                     renderer.render(out=out[camera][i])
         finally:
             self.world.set_state(current)

@@ -37,8 +37,9 @@ class World:
     """A compiled scene with a robot; the only place ``mj_step`` is called during execution."""
 
     def __init__(self, model: mujoco.MjModel, objects: dict[str, ObjectInstance],
-                 sim: SimConfig = SimConfig()) -> None:
+                 sim: SimConfig = SimConfig(), spec: mujoco.MjSpec | None = None) -> None:
         self.model = model
+        self.spec = spec  # what ``model`` was compiled from, if known (renderers rebuild it for drawing)
         self.data = mujoco.MjData(model)
         self.sim = sim
         self.objects = objects
