@@ -72,6 +72,8 @@ def batched_model(lod: mujoco.MjModel, spec: mujoco.MjSpec) -> tuple[mujoco.MjMo
                    tuple(np.round(lod.geom_rgba[g], 6)))
             groups[key].append(g)
     bodies = {b.name: b for b in spec.bodies}
+    tetrahedron = [0, 0, 0, 1e-3, 0, 0, 0, 1e-3, 0, 0, 0, 1e-3]  # for the replaced meshes' geoms
+    placeholder = spec.add_mesh(name=f"{BATCHED}_none", uservert=tetrahedron)
     # a geom alone is rewritten too: the robot's links, whose simplified meshes compile in no time
     for n, ((body, matid, group, rgba), parts) in enumerate(groups.items()):
         vertices, normals = _triangles(lod, parts)
@@ -87,8 +89,14 @@ def batched_model(lod: mujoco.MjModel, spec: mujoco.MjSpec) -> tuple[mujoco.MjMo
                                rgba=list(rgba), group=group, contype=0, conaffinity=0, mass=0)
         if matid >= 0:
             geom.material = lod.mat(matid).name
-        for g in parts:  # kept, not drawn (deleting from a spec costs milliseconds a geom)
+        for g in parts:  # kept, not drawn (deleting a geom from a spec costs milliseconds)
             geoms[g].group = UNDRAWN_GROUP
+            if int(lod.geom_type[g]) == int(_T.mjGEOM_MESH):
+                geoms[g].meshname = placeholder.name
+    used = {geom.meshname for geom in spec.geoms}
+    for mesh in list(spec.meshes):  # the robot's full visual meshes: neither compiled nor uploaded
+        if mesh.name not in used:
+            spec.delete(mesh)
     spec.stat.extent, spec.stat.center = float(lod.stat.extent), lod.stat.center.copy()
     model = lod_model(spec.compile(), keep=BATCHED)
     if model.nbody != lod.nbody or model.ncam != lod.ncam:
