@@ -64,6 +64,7 @@ def test_batched_frames_are_the_level_of_detail_frames(cluttered: World) -> None
 
 def test_the_batched_model_draws_fewer_geoms_with_the_same_bodies(cluttered: World) -> None:
     lod = lod_model(cluttered.model)
+    assert cluttered.spec is not None
     model, source = batching.batched(cluttered.model, cluttered.spec)
     drawn = [int(np.isin(m.geom_group, batching.DRAWN_GROUPS).sum()) for m in (lod, model)]
     assert drawn[1] < drawn[0] / 2, drawn

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 from collections import OrderedDict
 from dataclasses import dataclass
+from functools import partial
 
 import mujoco
 import numpy as np
@@ -37,10 +38,10 @@ class ComposedScene:
     model: mujoco.MjModel
     objects: dict[str, ObjectInstance]
     spec: SceneSpec
-    mjspec: mujoco.MjSpec | None = None  # what ``model`` was compiled from
+    sim: SimConfig = SimConfig()  # what ``model`` was compiled with
 
     def make_world(self, sim: SimConfig = SimConfig()) -> World:
-        return World(self.model, self.objects, sim, self.mjspec)
+        return World(self.model, self.objects, sim, partial(scene_spec, self.spec, self.sim))
 
 
 def _base_spec(sim: SimConfig) -> mujoco.MjSpec:
@@ -136,21 +137,8 @@ def compose(scene: SceneSpec, sim: SimConfig = SimConfig()) -> ComposedScene:
     if cached is not None:
         _MODEL_CACHE.move_to_end(key)
         return cached
-    spec = _base_spec(sim)  # rebuilt each time: MuJoCo caches the meshes, so this is cheap
-    _add_table(spec, scene.table)
-    _add_cameras(spec, scene)
-    spec.worldbody.add_light(name="key", pos=[0.6, -0.4, 2.6], dir=[-0.1, 0.2, -1.0],
-                             diffuse=[scene.light] * 3, specular=[0.1, 0.1, 0.1],
-                             castshadow=False)
     types = {o.name: CATALOG.get(o.type) for o in scene.objects}
-    for obj in scene.objects:
-        z = scene.table.height if obj.z is None else obj.z
-        otype = types[obj.name]
-        _add_object(spec, otype, obj.name, [obj.xy[0], obj.xy[1], z], obj.yaw, obj.scale,
-                    otype.color(obj.color), obj.friction)
-    spec.add_key(name="home")
-    # Room for the contacts of a cluttered (or badly placed) scene; pages are only touched as used.
-    spec.memory = ARENA_BASE + ARENA_PER_OBJECT * len(scene.objects)
+    spec = scene_spec(scene, sim)
     model = spec.compile()
     _set_home_key(model)
     objects = {
@@ -158,11 +146,31 @@ def compose(scene: SceneSpec, sim: SimConfig = SimConfig()) -> ComposedScene:
                                o.color or next(iter(types[o.name].colors)))
         for o in scene.objects
     }
-    composed = ComposedScene(model, objects, scene, spec)
+    composed = ComposedScene(model, objects, scene, sim)
     _MODEL_CACHE[key] = composed
     if len(_MODEL_CACHE) > _CACHE_SIZE:
         _MODEL_CACHE.popitem(last=False)
     return composed
+
+
+def scene_spec(scene: SceneSpec, sim: SimConfig = SimConfig()) -> mujoco.MjSpec:
+    """The ``MjSpec`` that :func:`compose` compiles (built afresh each call: MuJoCo caches the
+    meshes, so this is cheap; a spec kept after compiling holds tens of MiB)."""
+    spec = _base_spec(sim)
+    _add_table(spec, scene.table)
+    _add_cameras(spec, scene)
+    spec.worldbody.add_light(name="key", pos=[0.6, -0.4, 2.6], dir=[-0.1, 0.2, -1.0],
+                             diffuse=[scene.light] * 3, specular=[0.1, 0.1, 0.1],
+                             castshadow=False)
+    for obj in scene.objects:
+        z = scene.table.height if obj.z is None else obj.z
+        otype = CATALOG.get(obj.type)
+        _add_object(spec, otype, obj.name, [obj.xy[0], obj.xy[1], z], obj.yaw, obj.scale,
+                    otype.color(obj.color), obj.friction)
+    spec.add_key(name="home")
+    # Room for the contacts of a cluttered (or badly placed) scene; pages are only touched as used.
+    spec.memory = ARENA_BASE + ARENA_PER_OBJECT * len(scene.objects)
+    return spec
 
 
 def _set_home_key(model: mujoco.MjModel) -> None:

@@ -14,7 +14,9 @@ the geoms of a body saves no measurable time by itself (``benchmarks/render_lod.
 to their size does.
 
 The replaced geoms stay, moved to a group that is not drawn (deleting from a spec costs
-milliseconds a geom). Bodies, joints, cameras, lights and visual options are the spec's own: the
+milliseconds a geom), and the robot's full visual meshes are emptied (neither compiled nor
+uploaded). The spec is built afresh by the world's ``spec`` callable (keeping a compiled spec would
+hold tens of MiB). Bodies, joints, cameras, lights and visual options are the spec's own: the
 batched model has the original's bodies in the same order and draws any of its states once its
 kinematics are computed on its own data, which :class:`vcage.sim.render.Renderer` does before each
 frame. It is never stepped.
@@ -23,6 +25,7 @@ frame. It is never stepped.
 from __future__ import annotations
 
 from collections import OrderedDict, defaultdict
+from collections.abc import Callable
 
 import mujoco
 import numpy as np
@@ -46,14 +49,14 @@ _CACHE: OrderedDict[int, tuple[mujoco.MjModel, tuple[mujoco.MjModel, np.ndarray]
 _CACHE_SIZE = 2  # a run's renderers (critic views, videos) draw one scene after another
 
 
-def batched(model: mujoco.MjModel, spec: mujoco.MjSpec) -> tuple[mujoco.MjModel, np.ndarray]:
-    """:func:`batched_model` of ``model``'s level-of-detail copy, compiled once per model (the
-    last few are kept)."""
+def batched(model: mujoco.MjModel, spec: Callable[[], mujoco.MjSpec]) -> tuple[mujoco.MjModel, np.ndarray]:
+    """:func:`batched_model` of ``model``'s level-of-detail copy and its spec (built by ``spec``),
+    compiled once per model (the last few are kept)."""
     hit = _CACHE.get(id(model))
     if hit is not None and hit[0] is model:
         _CACHE.move_to_end(id(model))
         return hit[1]
-    out = batched_model(lod_model(model), spec)
+    out = batched_model(lod_model(model), spec())
     _CACHE[id(model)] = (model, out)
     while len(_CACHE) > _CACHE_SIZE:
         _CACHE.popitem(last=False)
@@ -61,9 +64,8 @@ def batched(model: mujoco.MjModel, spec: mujoco.MjSpec) -> tuple[mujoco.MjModel,
 
 
 def batched_model(lod: mujoco.MjModel, spec: mujoco.MjSpec) -> tuple[mujoco.MjModel, np.ndarray]:
-    """The batched model of ``spec`` (whose compiled model ``lod`` is the level-of-detail copy of),
-    and for each of its geoms the original geom it stands for (a merged geom: one of its parts)."""
-    spec = _copy(spec)
+    """The batched model of ``spec`` (whose compiled model ``lod`` is the level-of-detail copy of;
+    ``spec`` is changed), and for each of its geoms a geom of the original's it stands for."""
     geoms = _compiled_order(spec, lod)
     groups: dict[tuple, list[int]] = defaultdict(list)
     for g in range(lod.ngeom):
@@ -72,8 +74,7 @@ def batched_model(lod: mujoco.MjModel, spec: mujoco.MjSpec) -> tuple[mujoco.MjMo
                    tuple(np.round(lod.geom_rgba[g], 6)))
             groups[key].append(g)
     bodies = {b.name: b for b in spec.bodies}
-    tetrahedron = [0, 0, 0, 1e-3, 0, 0, 0, 1e-3, 0, 0, 0, 1e-3]  # for the replaced meshes' geoms
-    placeholder = spec.add_mesh(name=f"{BATCHED}_none", uservert=tetrahedron)
+    replaced: set[int] = set()
     # a geom alone is rewritten too: the robot's links, whose simplified meshes compile in no time
     for n, ((body, matid, group, rgba), parts) in enumerate(groups.items()):
         vertices, normals = _triangles(lod, parts)
@@ -91,27 +92,19 @@ def batched_model(lod: mujoco.MjModel, spec: mujoco.MjSpec) -> tuple[mujoco.MjMo
             geom.material = lod.mat(matid).name
         for g in parts:  # kept, not drawn (deleting a geom from a spec costs milliseconds)
             geoms[g].group = UNDRAWN_GROUP
-            if int(lod.geom_type[g]) == int(_T.mjGEOM_MESH):
-                geoms[g].meshname = placeholder.name
-    used = {geom.meshname for geom in spec.geoms}
-    for mesh in list(spec.meshes):  # the robot's full visual meshes: neither compiled nor uploaded
-        if mesh.name not in used:
-            spec.delete(mesh)
+            replaced.add(g)
+    # The robot's full visual meshes, which only replaced geoms draw, are emptied: neither compiled
+    # nor uploaded (emptied, not deleted: deleting a mesh from a spec never compiled corrupts the heap)
+    needed = {geoms[g].meshname for g in range(lod.ngeom) if g not in replaced}
+    for mesh in spec.meshes:
+        if mesh.name not in needed and not mesh.name.startswith(BATCHED):
+            mesh.file = ""
+            mesh.uservert = [0, 0, 0, 1e-3, 0, 0, 0, 1e-3, 0, 0, 0, 1e-3]  # a tetrahedron
     spec.stat.extent, spec.stat.center = float(lod.stat.extent), lod.stat.center.copy()
     model = lod_model(spec.compile(), keep=BATCHED)
     if model.nbody != lod.nbody or model.ncam != lod.ncam:
         raise ConfigError("the batched render model lost bodies or cameras; render with mesh_detail='full'")
     return model, _sources(model, lod)
-
-
-def _copy(spec: mujoco.MjSpec) -> mujoco.MjSpec:
-    """A copy of ``spec`` that compiles: a copied material keeps a texture list shorter than its
-    ten roles, which compiling the copy rejects ("texture '' not found"), so it is padded."""
-    out = spec.copy()
-    for material in out.materials:
-        names = list(material.textures)
-        material.textures = names + [""] * (int(mujoco.mjtTextureRole.mjNTEXROLE) - len(names))
-    return out
 
 
 def _compiled_order(spec: mujoco.MjSpec, model: mujoco.MjModel) -> list:

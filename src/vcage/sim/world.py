@@ -7,6 +7,7 @@ it appears, so an unstable rollout is never recorded.
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import mujoco
@@ -37,9 +38,10 @@ class World:
     """A compiled scene with a robot; the only place ``mj_step`` is called during execution."""
 
     def __init__(self, model: mujoco.MjModel, objects: dict[str, ObjectInstance],
-                 sim: SimConfig = SimConfig(), spec: mujoco.MjSpec | None = None) -> None:
+                 sim: SimConfig = SimConfig(), spec: Callable[[], mujoco.MjSpec] | None = None) -> None:
         self.model = model
-        self.spec = spec  # what ``model`` was compiled from, if known (renderers rebuild it for drawing)
+        # builds the MjSpec ``model`` was compiled from, if known (renderers recompile it for drawing)
+        self.spec = spec
         self.data = mujoco.MjData(model)
         self.sim = sim
         self.objects = objects
