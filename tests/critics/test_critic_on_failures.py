@@ -8,6 +8,7 @@ critic that rejects everything fails too.
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 
 from critics.faulted import Run, run
@@ -136,3 +137,24 @@ def test_the_checks_under_test_cover_every_image_check() -> None:
 
     tested = {p.split("(")[0] for *_, p in FAILURES}
     assert tested == set(IMAGE_CHECKS.names())
+
+
+def test_a_lone_pixel_at_the_outline_does_not_set_how_high_the_button_is() -> None:
+    """A pixel's depth at a silhouette can be far off: one at 0.25 m above the table on the 9 cm
+    clock made a light press look deep enough. The same light press, with such a pixel put on the
+    clock's outline in the view before it, is still refused for stopping short."""
+    from dataclasses import replace
+
+    from vcage.critics.masks import dilate
+
+    result = _run("upright", "press_light", 1)
+    obs = result.obs
+    view = obs.before["top"]
+    clock = view.segmentation == obs.labels.index("clock")
+    rows, cols = np.nonzero(clock & dilate(~clock, 1))  # the outline
+    depth = view.depth.copy()
+    depth[rows[0], cols[0]] = float(np.median(depth[view.segmentation == -1])) - 0.25
+    spoiled = replace(obs, before={**obs.before, "top": replace(view, depth=depth)})
+    verdict = CRITIC.judge(spoiled)
+    assert not verdict.accept
+    assert "short of pressing clock" in verdict.reason

@@ -175,7 +175,7 @@ def _landed_on_other(obs: Observation, top: View, a: str, b: str, inside: bool) 
     ma, mb = _mask(obs, top, a), _mask(obs, before, b)
     if not ma.any() or not mb.any():
         return None
-    rim = float(hb[mb].max())
+    rim = float(hb[_inner(mb)].max())
     surface = rim if inside else _surface(obs, b, rim)
     where = f"{b}'s {'rim' if inside else 'surface'}"
     height = _max_height(obs, a)
@@ -299,6 +299,14 @@ def _heights(view: View) -> np.ndarray | None:
     return float(np.median(view.depth[view.segmentation == -1])) - view.depth
 
 
+def _inner(mask: np.ndarray) -> np.ndarray:
+    """``mask`` without its outline (all of it, if nothing is left): a pixel's depth at a silhouette
+    can be far off (one at 0.25 m above the table on a 9 cm clock was seen), so an object's highest
+    point is read inside it."""
+    inner = mask & ~dilate(~mask, 1)
+    return inner if inner.any() else mask
+
+
 def _button_cover(obs: Observation, x: str) -> float | None:
     """Share of ``x``'s top (its pixels within :data:`TOP_BAND` of its highest point before the
     subtask, where a button or lever is) that the robot hides from the top view at the subtask's
@@ -312,7 +320,7 @@ def _button_cover(obs: Observation, x: str) -> float | None:
     mask = _mask(obs, before, x)
     if not mask.any():
         return None
-    top = mask & (hb >= hb[mask].max() - TOP_BAND)
+    top = mask & (hb >= hb[_inner(mask)].max() - TOP_BAND)
     return float(((during.segmentation == ROBOT) & top).sum() / top.sum())
 
 
@@ -332,7 +340,7 @@ def _press_shortfall(obs: Observation, x: str) -> float | None:
     over = (during.segmentation == ROBOT) & mask
     if not over.any():
         return None
-    top = float(hb[mask].max())  # the button (lever) at rest: the object's highest point
+    top = float(hb[_inner(mask)].max())  # the button (lever) at rest: the object's highest point
     scale = top / point.pos[2]  # the press point at rest is the highest point
     full = (point.travel if point.kind == "button" else point.stroke) * scale
     tcp = float(hd[over].max()) - HAND_TOP
