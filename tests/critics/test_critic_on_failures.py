@@ -8,11 +8,14 @@ critic that rejects everything fails too.
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
 from critics.faulted import Run, run
-from vcage.critics.image import ImageCritic
+from vcage.critics.image import ROBOT, ImageCritic
+from vcage.critics.masks import touch
 from vcage.planning.goals import press, put_in, put_on
 from vcage.planning.schema import Predicate, Subtask
 from vcage.scene.spec import ObjectSpec as O
@@ -121,6 +124,27 @@ def test_an_object_put_down_on_clutter_that_lies_on_its_target_is_not_on_it() ->
     verdict = CRITIC.judge(result.obs)
     assert not verdict.accept
     assert "mouse lies over block" in verdict.reason
+
+
+def test_a_press_hidden_from_the_front_by_a_cup_is_judged_from_the_top() -> None:
+    """A cup stands between the bell and the front camera: the fingers go down behind it, so the
+    front view shows no contact. The top view's cover and depth say the press was full; a press
+    beside the button, equally hidden, still fails the cover."""
+    objects = (*BELL, O("cup", "cup", (0.62, 0.05)))
+    done = run(objects, press("bell", "the bell is rung"))
+    front = done.obs.during["front"]
+    bell = front.segmentation == done.obs.labels.index("bell")
+    assert done.success and not touch(front.segmentation == ROBOT, bell, front.depth)
+    verdict = CRITIC.judge(done.obs)
+    assert verdict.accept, verdict.reason
+    blind = {m: {c: replace(v, depth=None) if c == "top" else v for c, v in getattr(done.obs, m).items()}
+             for m in ("before", "during", "after")}
+    verdict = CRITIC.judge(replace(done.obs, **blind))  # without the top view's depth: no evidence left
+    assert not verdict.accept and "hides where the hand met bell" in verdict.reason, verdict.reason
+    missed = run(objects, press("bell", "the bell is rung"), "press_miss", 0)
+    assert missed.outcome.oracle["pressed(bell)"] is False
+    verdict = CRITIC.judge(missed.obs)
+    assert not verdict.accept and "covered" in verdict.reason, verdict.reason
 
 
 def test_a_press_is_judged_at_its_own_lowest_moment() -> None:

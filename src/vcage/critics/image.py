@@ -24,7 +24,9 @@ simulator state. Each predicate is checked in image space:
   above the hand's centre between the fingertips when the hand points down (as it does to press),
   and at a full press that centre is :data:`FINGER_CONTACT` minus the button's travel (a lever's
   stroke), scaled by ``x``'s size, above ``x``'s highest point before. A press that stops short of
-  :data:`PRESS_SHARE` of that is refused.
+  :data:`PRESS_SHARE` of that is refused. Where the hand goes down behind an object standing in front
+  of ``x`` (a cup before a bell), the front view cannot show the contact; then the top view's cover
+  and depth, both required, decide.
 - ``upright(x)``: ``x``'s top-view area (orthographic, so true to size wherever it stands) and the
   spread of its outline are close to what they were before, allowing for what the robot can hide;
   its front-view height did not drop.
@@ -86,6 +88,9 @@ PRESS_SHARE = {"button": 0.75, "lever": 0.5}
 # metres of its highest point, where the button or lever is) must be this much hidden by the robot
 TOP_BAND = 0.004
 BUTTON_COVER = 0.8
+# Metres by which an object below the hand's lowest pixel in the front view must be nearer the camera
+# than the hand to hide where the hand goes down (a cup's rim 1.3 cm in front of the fingers was seen)
+NEARER = 0.005
 
 
 class ImageCritic(Critic):
@@ -267,8 +272,11 @@ def _pressed(obs: Observation, x: str) -> tuple[bool, str]:
     if front is None or top is None:
         return False, "no view of the press"
     mx_front = _mask(obs, front, x)
+    hidden = False
     if not touch(front.segmentation == ROBOT, mx_front, front.depth):
-        return False, f"the hand never touched {x}"
+        hidden = _contact_hidden(obs, front, x)
+        if not hidden:
+            return False, f"the hand never touched {x}"
     mx_top = _mask(obs, top, x)
     before = obs.before.get(TOP)
     if before is not None:  # the hand hides ``x`` from the top: use its outline from before
@@ -277,12 +285,33 @@ def _pressed(obs: Observation, x: str) -> tuple[bool, str]:
     if not np.any(dilate(top.segmentation == ROBOT, TOUCH) & outline):
         return False, f"the hand was not over {x}"
     cover = _button_cover(obs, x)
+    if hidden and (cover is None or _press_shortfall(obs, x) is None):
+        return False, f"an object in front hides where the hand met {x}, and the top view cannot measure it"
     if cover is not None and cover < BUTTON_COVER:
         return False, f"the hand covered {cover:.0%} of {x}'s top (its button) at its lowest"
     short = _press_shortfall(obs, x)
     if short is not None and short > 0:
         return False, f"the hand stopped {1000 * short:.1f} mm short of pressing {x} down its travel"
     return True, "the hand touched and covered it at its lowest"
+
+
+def _contact_hidden(obs: Observation, front: View, x: str) -> bool:
+    """The hand goes down behind another object in the front view, over ``x``'s columns: its lowest
+    pixels there border an object nearer the camera than the hand, so whether it met ``x`` cannot be
+    seen from the front (a cup standing in front of a bell). Where the hand ends above the table or
+    beside ``x`` in plain sight, its contact (or its absence) is visible."""
+    seg, depth = front.segmentation, front.depth
+    mask = _mask(obs, front, x)
+    if FRONT in obs.before:  # what the hand or the occluder hides now may have shown before
+        mask = mask | _mask(obs, obs.before[FRONT], x)
+    if depth is None or not mask.any():
+        return False
+    robot = seg == ROBOT
+    below, below_depth = seg[1:], depth[1:]
+    occluder = (robot[:-1] & (below >= 0) & (below != obs.labels.index(x))
+                & (below_depth < depth[:-1] - NEARER))
+    cols = np.nonzero(mask.any(axis=0))[0]  # the columns x spans (its visible parts may be slivers)
+    return bool(occluder[:, max(cols[0] - TOUCH, 0):cols[-1] + TOUCH + 1].any())
 
 
 def _touch_depth(view: View) -> np.ndarray | None:
