@@ -126,6 +126,18 @@ def test_an_object_put_down_on_clutter_that_lies_on_its_target_is_not_on_it() ->
     assert "mouse lies over block" in verdict.reason
 
 
+def test_a_block_put_down_where_another_stands_is_not_on_the_table() -> None:
+    """Put down at a spot another block of its size occupies, the block comes to rest on it: from the
+    top it shows where it should, and its neighbour, no larger, mostly hides under it. The heights of
+    the top view say it stands a block higher than the table allows."""
+    objects = (O("a", "block", (0.5, -0.12)), O("b", "block", (0.55, 0.05)))
+    result = run(objects, _sub("pick_and_place", {"obj": "a", "xy": [0.55, 0.05]},
+                               ("on_table", ("a",)), ("released", ("a",))))
+    assert result.outcome.oracle == {"on_table(a)": False, "released(a)": True}
+    verdict = CRITIC.judge(result.obs)
+    assert not verdict.accept and "higher than resting on the table allows" in verdict.reason, verdict.reason
+
+
 def test_a_press_hidden_from_the_front_by_a_cup_is_judged_from_the_top() -> None:
     """A cup stands between the bell and the front camera: the fingers go down behind it, so the
     front view shows no contact. The top view's cover and depth say the press was full; a press

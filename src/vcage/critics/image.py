@@ -174,24 +174,36 @@ def _landed_on_other(obs: Observation, top: View, a: str, b: str, inside: bool) 
       still there (followed if it was pushed), so ``a`` lies above ``c`` and cannot be down on ``b``.
     """
     before = obs.before.get(TOP)
-    hb, ha = (_heights(before), _heights(top)) if before is not None else (None, None)
-    if before is None or hb is None or ha is None:
+    hb = _heights(before) if before is not None else None
+    if before is None or hb is None:
         return None
-    ma, mb = _mask(obs, top, a), _mask(obs, before, b)
-    if not ma.any() or not mb.any():
+    mb = _mask(obs, before, b)
+    if not mb.any():
         return None
     rim = float(hb[_inner(mb)].max())
     surface = rim if inside else _surface(obs, b, rim)
-    where = f"{b}'s {'rim' if inside else 'surface'}"
+    return _not_down(obs, top, a, surface, rim, f"{b}'s {'rim' if inside else 'surface'}", (a, b))
+
+
+def _not_down(obs: Observation, top: View, a: str, surface: float | None, floor: float, where: str,
+              skip: tuple[str, ...]) -> str | None:
+    """Why ``a`` cannot rest on a support whose surface lies ``surface`` above the table (``where``
+    names it), from the top view's heights; None if they allow it (or cannot tell). Without a known
+    surface only clutter higher than ``floor`` counts (see :func:`_landed_on_other`)."""
+    before = obs.before.get(TOP)
+    hb, ha = (_heights(before), _heights(top)) if before is not None else (None, None)
+    ma = _mask(obs, top, a)
+    if before is None or hb is None or ha is None or not ma.any():
+        return None
     height = _max_height(obs, a)
     if surface is not None and height is not None:
         above = float(ha[ma].min()) - height - surface
         if above > HEIGHT_TOL:
             return f"{a} stands {100 * above:.1f} cm higher than resting on {where} allows"
-    surface = rim if surface is None else surface
+    surface = floor if surface is None else surface
     for i, c in enumerate(obs.labels):
         was = before.segmentation == i
-        if c in (a, b) or not was.any():
+        if c in skip or not was.any():
             continue
         now = top.segmentation == i
         dr, dc = (0, 0)
@@ -422,6 +434,9 @@ def _on_table(obs: Observation, a: str) -> tuple[bool, str]:
         mo = top.segmentation == i
         if mo.sum() > ma.sum() and (ma & hull(mo)).sum() > MIN_OVERLAP * ma.sum():
             return False, f"{a} lies over {other}, not on the table"
+    why = _not_down(obs, top, a, 0.0, 0.0, "the table", (a,))  # heights are above the table
+    if why is not None:
+        return False, why
     return True, "on the table"
 
 
