@@ -434,9 +434,9 @@ def _on_table(obs: Observation, a: str) -> tuple[bool, str]:
         mo = top.segmentation == i
         if mo.sum() > ma.sum() and (ma & hull(mo)).sum() > MIN_OVERLAP * ma.sum():
             return False, f"{a} lies over {other}, not on the table"
-    why = _not_down(obs, top, a, 0.0, 0.0, "the table", (a,))  # heights are above the table
-    if why is not None:
-        return False, why
+    high = _not_down(obs, top, a, 0.0, 0.0, "the table", (a,))  # heights are above the table
+    if high is not None:
+        return False, high
     return True, "on the table"
 
 
