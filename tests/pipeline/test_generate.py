@@ -6,6 +6,7 @@ import json
 from dataclasses import replace
 from pathlib import Path
 
+import mujoco
 import numpy as np
 import pytest
 
@@ -46,6 +47,8 @@ def test_generate_writes_a_verified_dataset(tmp_path: Path) -> None:
     seconds = stats["seconds"]
     assert seconds["physics"] > 0 and seconds["render"] > 0
     assert seconds["physics"] + seconds["render"] <= stats["wall_seconds"]
+    # the versions the episodes depend on (the same seed gives the same episode only under them)
+    assert stats["software"]["mujoco"] == mujoco.__version__ and stats["software"]["mink"] != "absent"
     report = audit(out)
     assert report.accepted == 1 and report.agreement == 1.0 and report.judged_subtasks == 2
 

@@ -33,6 +33,7 @@ from vcage.pipeline.sampling import EpisodeRun, build_critic, camera_key
 from vcage.pipeline.stage import Stage
 from vcage.planning import make_planner
 from vcage.planning.schema import Plan
+from vcage.provenance import software
 
 
 @dataclass
@@ -123,7 +124,8 @@ def generate(instruction: str, episodes: int, out: Path | str, cfg: GenerateConf
         funnel.dataset_episodes = writer.num_episodes
         funnel.wall = time.perf_counter() - t0
         if writer.num_episodes:
-            attempt_log.append(out / RUNS_LOG, [{"instruction": plan.instruction, **funnel.to_dict()}])
+            attempt_log.append(out / RUNS_LOG, [{"instruction": plan.instruction, **funnel.to_dict(),
+                                                  "software": software()}])
     return funnel
 
 

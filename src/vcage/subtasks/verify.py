@@ -12,16 +12,13 @@ least one trial succeeded); ``accepted``.
 
 from __future__ import annotations
 
-import platform
 from collections import Counter
 from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass
 
-import mujoco
-
-import vcage
 from vcage.critics.base import Critic
 from vcage.errors import CodeRejectedError, SubtaskError
+from vcage.provenance import software
 from vcage.sandbox import check
 from vcage.sandbox.protocol import QUERIES
 from vcage.scene.spec import SceneSpec
@@ -54,8 +51,7 @@ class Funnel:
 
 
 def versions(critic: Critic | None) -> dict[str, str]:
-    return {"vcage": vcage.__version__, "mujoco": mujoco.__version__, "python": platform.python_version(),
-            "schema": str(SCHEMA_VERSION)}
+    return {**software(), "schema": str(SCHEMA_VERSION)}
 
 
 def static_check(cand: Candidate, spec: SceneSpec) -> str | None:
