@@ -11,10 +11,19 @@ skill error (no silent failure) is left out, and so is a sample whose earlier su
 Each critic judges the views it would get in a run (before, during and after the subtask). Printed
 per skill family and per fault: the sample's composition (successes, failures, distinct scenes),
 balanced accuracy, false-accept rate (failures accepted) and false-reject rate (successes
-rejected); "n/a" where a denominator is empty. The VLM critic is not measured here: the local fake
-server answers from a script, which would measure the script.
+rejected); "n/a" where a denominator is empty.
 
     nice .venv/bin/python benchmarks/critic_failures.py --seeds 2 --workers 2 --cache /tmp/cf
+
+The VLM critic judges the same samples with ``--vlm-tape FILE``: it talks to a local
+OpenAI-compatible endpoint (``benchmarks/vlm_tape.py``) that, with ``--vlm-record``, forwards each
+question to the model named by ``VCAGE_VLM_BASE_URL``, ``VCAGE_VLM_MODEL`` and ``VCAGE_VLM_API_KEY``
+and keeps its answers on the tape, and otherwise answers from the tape, so a measurement made once
+against a real model can be re-printed (and audited answer by answer) without it:
+
+    VCAGE_VLM_BASE_URL=https://... VCAGE_VLM_MODEL=... VCAGE_VLM_API_KEY=... \
+        .venv/bin/python benchmarks/critic_failures.py --seeds 5 --first-seed 5 --faults-per-seed 3 \
+        --cache DIR --vlm-tape vlm.jsonl --vlm-record
 
 ``--cache DIR`` stores every sample's observation (and re-uses it on the next run, so a changed
 critic is re-judged without simulating again).
@@ -38,8 +47,11 @@ os.environ.setdefault("LP_NUM_THREADS", "1")  # one rasteriser thread: a worker 
 
 import numpy as np  # noqa: E402
 
+from vcage.backends import BackendConfig  # noqa: E402
 from vcage.critics import Critic, CriticConfig, Observation, Verdict, make_critic  # noqa: E402
 from vcage.critics.base import View  # noqa: E402
+from vcage.critics.vlm import ENV_PREFIX as VLM_ENV  # noqa: E402
+from vcage.errors import VcageError  # noqa: E402
 from vcage.pipeline.config import GenerateConfig  # noqa: E402
 from vcage.pipeline.episode import Timing  # noqa: E402
 from vcage.pipeline.plan_layout import plan_layout  # noqa: E402
@@ -54,6 +66,7 @@ from vcage.skills.base import Skills  # noqa: E402
 from vcage.skills.faults import FaultConfig, FaultInjector, faults_for  # noqa: E402
 from vcage.skills.playback import Player  # noqa: E402
 from vcage.skills.reachability import reach_map  # noqa: E402
+from vlm_tape import Tape, tape_model  # noqa: E402
 
 DEFAULT_GOALS = ("get_ready_for_work", "prepare_breakfast", "tidy_the_desk", "set_the_table",
                  "build_a_tower", "sort_blocks_by_colour")
@@ -207,7 +220,14 @@ def main() -> None:
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--cache", default=None, help="directory for the samples' observations")
     parser.add_argument("--show-errors", action="store_true", help="print each misjudged sample")
+    parser.add_argument("--vlm-tape", default=None, help="also judge with the VLM critic, through a local "
+                        "endpoint that answers from this tape of a model's answers")
+    parser.add_argument("--vlm-record", action="store_true", help="with --vlm-tape: ask the model of the "
+                        f"{VLM_ENV}_* variables and add its answers to the tape")
+    parser.add_argument("--vlm-votes", type=int, default=1, help="questions per judgment (majority)")
     args = parser.parse_args()
+    if args.vlm_record and not args.vlm_tape:
+        parser.error("--vlm-record needs --vlm-tape FILE")
     todo = jobs(args.goals, args.seeds, args.faults_per_seed, args.cache, args.first_seed)
     t0 = time.perf_counter()
     with ProcessPoolExecutor(args.workers) as pool:
@@ -238,10 +258,40 @@ def main() -> None:
         verdicts = [critic.judge(seen(s.obs)) for s in samples]
         report(samples, label, [v.accept for v in verdicts])
         if args.show_errors:
-            for s, v in zip(samples, verdicts, strict=True):
-                if v.accept != s.success:
-                    print(f"  {'FA' if v.accept else 'FR'} {s.goal}#{s.subtask + 1} seed {s.seed} "
-                          f"{s.fault or '-'}: {v.reason}; oracle {s.obs.oracle}")
+            errors(samples, verdicts)
+    if args.vlm_tape:
+        judge_vlm(samples, Path(args.vlm_tape), args.vlm_record, args.vlm_votes, args.show_errors)
+
+
+def errors(samples: list[Sample], verdicts: list[Verdict]) -> None:
+    for s, v in zip(samples, verdicts, strict=True):
+        if v.accept != s.success:
+            print(f"  {'FA' if v.accept else 'FR'} {s.goal}#{s.subtask + 1} seed {s.seed} "
+                  f"{s.fault or '-'}: {v.reason}; oracle {s.obs.oracle}")
+
+
+def judge_vlm(samples: list[Sample], tape_path: Path, record: bool, votes: int, show_errors: bool) -> None:
+    """The VLM critic on ``samples``, through :class:`vlm_tape.Tape` (recording or replaying)."""
+    try:
+        upstream = BackendConfig.from_env(VLM_ENV) if record else None
+    except VcageError as exc:
+        raise SystemExit(f"error: {exc} (--vlm-record asks the model those variables name)") from exc
+    model = upstream.model if upstream is not None else tape_model(tape_path)
+    if model is None:
+        raise SystemExit(f"error: no answers on the tape {tape_path}: record them with --vlm-record")
+    with Tape(tape_path, upstream) as tape:
+        critic = make_critic(CriticConfig("vlm", backend=BackendConfig(base_url=tape.base_url, model=model),
+                                          votes=votes))
+        try:
+            critic.preflight()
+            verdicts = [critic.judge(s.obs) for s in samples]
+        except VcageError as exc:
+            raise SystemExit(f"error: the VLM critic could not judge: {exc}") from exc
+    malformed = sum(int(v.details.get("malformed", 0)) for v in verdicts)
+    report(samples, f"vlm ({model}; {votes} vote(s); answers {'recorded to' if record else 'replayed from'} "
+           f"{tape_path.name}; {tape.served} answered, {malformed} malformed)", [v.accept for v in verdicts])
+    if show_errors:
+        errors(samples, verdicts)
 
 
 if __name__ == "__main__":
