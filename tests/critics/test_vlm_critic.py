@@ -7,10 +7,12 @@ is unusable stays a malformed vote. Every case runs over real HTTP against ``Fak
 
 from __future__ import annotations
 
+import base64
 import json
 import pickle
 import time
 from collections.abc import Iterator
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
@@ -18,10 +20,11 @@ import pytest
 
 from backends.fake_openai import Delay, FakeOpenAI, Reply, Status
 from vcage.backends import BackendConfig, ChatBackend, make_backend
+from vcage.backends.messages import encode_png
 from vcage.critics.base import CriticConfig, Observation, View, make_critic
 from vcage.critics.vlm import SYSTEM, VLMCritic, parse_answer
 from vcage.errors import BackendError, BackendTimeout, BackendUnavailableError, ConfigError
-from vcage.planning.goals import put_on
+from vcage.planning.goals import press, put_on
 
 YES = json.dumps({"success": True, "reason": "the mouse is on the pad"})
 NO = json.dumps({"success": False, "reason": "the mouse is beside the pad"})
@@ -83,6 +86,22 @@ def test_yes_accepts_and_sends_three_images(server: FakeOpenAI) -> None:
     images = [p for p in content if p["type"] == "image_url"]
     assert len(images) == 3 and images[0]["image_url"]["url"].startswith("data:image/png;base64,")
     assert '"the mouse lies on the pad"' in content[0]["text"]
+
+
+def test_a_press_is_shown_at_its_lowest_moment(server: FakeOpenAI) -> None:
+    """No image after a press shows it: the question adds the two views at the press's lowest moment."""
+    server.script(YES, YES)
+    obs = _obs()
+    lowest = {"top": View(obs.before["top"].rgb + 90, obs.before["top"].segmentation),
+              "front": View(obs.before["front"].rgb + 120, obs.before["front"].segmentation)}
+    critic = _critic(server)
+    assert critic.judge(replace(obs, subtask=press("bell", "the bell is rung"), during=lowest)).accept
+    content = server.requests[0]["messages"][1]["content"]
+    images = [p["image_url"]["url"] for p in content if p["type"] == "image_url"]
+    assert len(images) == 5 and "at the press's lowest moment, from the front" in content[0]["text"]
+    assert images[2] == "data:image/png;base64," + base64.b64encode(encode_png(lowest["front"].rgb)).decode()
+    critic.judge(replace(obs, during=lowest))  # a place is judged from its outcome: three images
+    assert len([p for p in server.requests[1]["messages"][1]["content"] if p["type"] == "image_url"]) == 3
 
 
 def test_no_rejects_with_the_models_reason(server: FakeOpenAI) -> None:
