@@ -276,6 +276,10 @@ def judge_vlm(samples: list[Sample], tape_path: Path, record: bool, votes: int, 
         upstream = BackendConfig.from_env(VLM_ENV) if record else None
     except VcageError as exc:
         raise SystemExit(f"error: {exc} (--vlm-record asks the model those variables name)") from exc
+    if upstream is not None and upstream.provider != "openai":
+        raise SystemExit(f"error: the tape speaks the OpenAI protocol; {VLM_ENV}_PROVIDER="
+                         f"{upstream.provider} is not forwarded (Gemini also serves an OpenAI-compatible "
+                         "endpoint)")
     model = upstream.model if upstream is not None else tape_model(tape_path)
     if model is None:
         raise SystemExit(f"error: no answers on the tape {tape_path}: record them with --vlm-record")
