@@ -188,7 +188,7 @@ def main() -> None:
     print(f"faces: scene {int(full_faces.sum()):,} -> {int(simple_faces.sum()):,}; the {len(heavy)} "
           f"simplified meshes {int(full_faces[heavy].sum()):,} -> {int(simple_faces[heavy].sum()):,}")
     t0 = time.perf_counter()
-    batched_model = batching.batched_model(simple_model, world.spec)[0]
+    batched_model = batching.batched_model(simple_model, world.spec())[0]
     drawn = [int(np.isin(m.geom_group, batching.DRAWN_GROUPS).sum()) for m in (simple_model, batched_model)]
     print(f"geoms drawn: {drawn[0]} -> {drawn[1]} batched per body and look (compiled in "
           f"{time.perf_counter() - t0:.2f} s)\n")
