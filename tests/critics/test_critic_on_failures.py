@@ -18,7 +18,12 @@ from vcage.critics.image import ROBOT, ImageCritic
 from vcage.critics.masks import touch
 from vcage.planning.goals import press, put_in, put_on
 from vcage.planning.schema import Predicate, Subtask
+from vcage.scene.compose import compose
 from vcage.scene.spec import ObjectSpec as O
+from vcage.scene.spec import SceneSpec
+from vcage.sim.render import Renderer
+from vcage.subtasks.judge import render_views
+from vcage.tasks import predicates as P
 
 CRITIC = ImageCritic()
 
@@ -124,6 +129,25 @@ def test_an_object_put_down_on_clutter_that_lies_on_its_target_is_not_on_it() ->
     verdict = CRITIC.judge(result.obs)
     assert not verdict.accept
     assert "mouse lies over block" in verdict.reason
+
+
+def test_a_mouse_on_its_back_on_the_pad_is_not_on_it() -> None:
+    """Vanilla rollouts left mice on their backs on the pad (the oracle: not on it; its outline from
+    the top is the same). No injected fault turns one over reliably, so the "after" views here are of
+    the same pad with the mouse set on its back and settled; the "before" views are the rollout's.
+    The mouse's domed top was far from a plane; its flat underside is not."""
+    done = run(MOUSE_PAD, put_on("mouse", "pad", "the mouse is on the pad"))
+    assert done.success and CRITIC.judge(done.obs).accept
+    world = compose(SceneSpec(objects=(O("mouse", "mouse", (0.55, 0.12), z=0.9), MOUSE_PAD[1]))).make_world()
+    adr = world.model.jnt_qposadr[world.model.body_jntadr[world.object("mouse").body_id]]
+    world.data.qpos[adr + 3:adr + 7] = (0.0, 1.0, 0.0, 0.0)  # half a turn about x
+    world.forward()
+    world.settle(1.0)
+    assert not P.on(world, "mouse", "pad")
+    with Renderer(world, 320, 240) as renderer:
+        after = render_views(renderer)
+    verdict = CRITIC.judge(replace(done.obs, after=after))
+    assert not verdict.accept and "turned over" in verdict.reason, verdict.reason
 
 
 def test_a_block_put_down_where_another_stands_is_not_on_the_table() -> None:

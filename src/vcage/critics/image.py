@@ -13,7 +13,8 @@ simulator state. Each predicate is checked in image space:
   lowest pixel row lies within ``b``'s rows (for ``inside``, no lower than ``b``'s bottom). With the
   top view's depth, ``a`` is down on ``b``: its lowest point is no higher than its type's height
   above ``b``'s surface (for ``inside``, its rim), and it does not lie over another object that
-  stood higher than that surface before the subtask (clutter on the target).
+  stood higher than that surface before the subtask (clutter on the target); an object that stood on
+  its base with a curved top before and shows a flat one now lies turned over.
 - ``released(a)``: after the retreat, the robot does not touch ``a`` in every view that shows it
   (a projection overlap in one view is not contact); ``a`` hidden in every view is not released.
 - ``pressed(x)``: in the views at the subtask's deepest moment the robot touches ``x`` (front view,
@@ -30,7 +31,8 @@ simulator state. Each predicate is checked in image space:
 - ``upright(x)``: ``x``'s top-view area (orthographic, so true to size wherever it stands) and the
   spread of its outline are close to what they were before, allowing for what the robot can hide;
   its front-view height did not drop.
-- ``on_table(a)``: released and not over another object in the top view.
+- ``on_table(a)``: released, not over another object in the top view, and down on the table by the
+  top view's heights (as for ``on``).
 - ``left_of`` / ``right_of``: column order in the top view (+y, the robot's left, is image left).
 - ``near(a, b)``: the centroids of the two masks in the top view are within the oracle's 10 cm,
   measured with the orthographic view's pixel size.
@@ -72,6 +74,16 @@ HEIGHT_RATIO = 0.8  # front-view height after / before for an object that stayed
 SUPPORT_TOL = 0.02
 HEIGHT_TOL = 0.01
 UNDER_PX = 4
+# A placed object's top keeps its shape: one whose top lay at least CURVED metres (RMS) from a plane
+# before the subtask and under FLAT_TOP of that after it shows a flat face it did not show before
+# (a mouse on its back); MIN_RELIEF_PX inner pixels are needed to tell
+CURVED = 0.003
+FLAT_TOP = 0.3
+MIN_RELIEF_PX = 12
+# ... judged only for an object that stood on its base before: its top-view area between these shares
+# of its type's footprint (size x by size y, times its smallest and largest scale squared); a round
+# or rounded object covers about 0.8 of it
+FOOTPRINT = (0.6, 1.15)
 COL_MARGIN = 2  # pixels of column separation for left_of / right_of
 NEAR = 0.1  # metres between the centroids for ``near`` (the oracle's distance)
 LIFT_ROWS = 8  # front-view pixel rows (of 240) an object's bottom must rise to count as lifted
@@ -150,7 +162,7 @@ def _rests_on(obs: Observation, a: str, b: str, inside: bool) -> tuple[bool, str
         return False, f"only {overlap:.0%} of {a} overlaps {b} from the top"
     if not centroid_in(ma, mb, CENTRE_TOL):
         return False, f"the centre of {a} is not over {b} from the top"
-    other = _landed_on_other(obs, top, a, b, inside)
+    other = _landed_on_other(obs, top, a, b, inside) or _turned_over(obs, top, a)
     if other is not None:
         return False, other
     fa, fb = rows_of(_mask(obs, front, a)), rows_of(_mask(obs, front, b) | _mask(obs, front, a))
@@ -216,6 +228,41 @@ def _not_down(obs: Observation, top: View, a: str, surface: float | None, floor:
         if rise > SUPPORT_TOL:
             return f"{a} lies over {c}, whose top is {100 * rise:.1f} cm above {where}"
     return None
+
+
+def _relief(view: View, mask: np.ndarray) -> float | None:
+    """How far (RMS, metres) the heights of ``mask``'s inner pixels lie from the plane that fits them
+    best: a dome's top lies far from any plane, a flat face on it (tilted or not)."""
+    heights, inner = _heights(view), _inner(mask)
+    if heights is None or inner.sum() < MIN_RELIEF_PX:
+        return None
+    rows, cols = np.nonzero(inner)
+    design = np.column_stack([rows, cols, np.ones_like(rows)]).astype(float)
+    coef, *_ = np.linalg.lstsq(design, heights[inner], rcond=None)
+    return float(np.sqrt(np.mean((design @ coef - heights[inner]) ** 2)))
+
+
+def _turned_over(obs: Observation, top: View, a: str) -> str | None:
+    """Why ``a`` lies turned over (None if its top kept its shape, or the views cannot tell): it stood
+    on its base before the subtask (see :data:`FOOTPRINT`) with a curved top (at least :data:`CURVED`
+    from a plane), and its top is now nearly flat (under :data:`FLAT_TOP` of that), as a mouse on its
+    back shows its flat underside. Containers are left out: how much of their inside shows changes
+    with what stands around them."""
+    otype = CATALOG.get(obs.types[a]) if obs.types.get(a) in CATALOG else None
+    before = obs.before.get(TOP)
+    if (otype is None or before is None or before.pixel_size is None
+            or any(p.kind == "in" for p in otype.placements)):
+        return None
+    mask = _mask(obs, before, a)
+    lo, hi = otype.scale_range
+    share = mask.sum() * before.pixel_size ** 2 / (otype.size[0] * otype.size[1])
+    if not FOOTPRINT[0] * lo ** 2 <= share <= FOOTPRINT[1] * hi ** 2:
+        return None  # not standing on its base before (a tilted block shows a side: two faces, no plane)
+    was, now = _relief(before, mask), _relief(top, _mask(obs, top, a))
+    if was is None or now is None or was < CURVED or now >= FLAT_TOP * was:
+        return None
+    return (f"{a}'s top is flat now ({1000 * now:.1f} mm from a plane, {1000 * was:.1f} mm before): "
+            "it lies turned over")
 
 
 def _surface(obs: Observation, b: str, top: float) -> float | None:
