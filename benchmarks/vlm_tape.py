@@ -5,7 +5,8 @@ A VLM critic measured on a benchmark talks to this server (``base_url``), never 
 - recording (``upstream`` given): every ``POST /chat/completions`` is forwarded to the upstream
   endpoint with its API key, and each answer (HTTP 200) is appended to the tape, a JSON-lines file;
   errors (rate limits, outages) are passed on to the client, which retries, and are not kept;
-  ``GET /models`` is forwarded too;
+  ``GET /models`` is forwarded too. What the tape already holds is answered from it, so recording
+  again after an interruption asks the model only what is missing;
 - replaying (no upstream): each request is answered from the tape, so a measurement is reproduced
   without the endpoint, its key or its cost. A request that is not on the tape is answered 404 with
   a message saying so (the backend raises, nothing is made up).
@@ -52,17 +53,15 @@ class Tape:
     def __init__(self, path: str | Path, upstream: BackendConfig | None = None) -> None:
         self.path = Path(path)
         self.upstream = upstream
+        if upstream is None and not self.path.is_file():
+            raise FileNotFoundError(f"no tape at {self.path}: record one first (against a real endpoint)")
         self.answers: dict[tuple[str, int], dict[str, Any]] = {}
-        if upstream is None:
-            if not self.path.is_file():
-                raise FileNotFoundError(f"no tape at {self.path}: record one first (against a real endpoint)")
-            for line in self.path.read_text().splitlines():
-                if line.strip():
-                    entry = json.loads(line)
-                    self.answers[(entry["key"], entry["n"])] = entry
+        for line in self.path.read_text().splitlines() if self.path.is_file() else []:
+            if line.strip():
+                entry = json.loads(line)
+                self.answers[(entry["key"], entry["n"])] = entry
         self.seen: Counter[str] = Counter()
-        self.served = 0  # chat requests answered (recorded or replayed)
-        self.missing = 0  # chat requests the tape did not hold
+        self.served = 0  # chat requests answered (from the tape or the model)
         self._lock = threading.Lock()
         self._server = ThreadingHTTPServer(("127.0.0.1", 0), self._handler())
         self._thread = threading.Thread(target=self._server.serve_forever, daemon=True)
@@ -85,17 +84,15 @@ class Tape:
         key = request_key(body)
         with self._lock:
             n = self.seen[key]
-        if self.upstream is None:
             entry = self.answers.get((key, n))
-            with self._lock:
-                if entry is None:
-                    self.missing += 1
-                    return 404, {"error": {"message": f"this request (answer {n + 1} to it) is not on the "
-                                                      f"tape {self.path}: record it against a real endpoint",
-                                           "type": "not_found_error"}}
+            if entry is not None:  # on the tape already (recording again only adds what is missing)
                 self.seen[key] += 1
                 self.served += 1
-            return 200, entry["response"]
+                return 200, entry["response"]
+        if self.upstream is None:
+            return 404, {"error": {"message": f"this request (answer {n + 1} to it) is not on the tape "
+                                              f"{self.path}: record it against a real endpoint",
+                                   "type": "not_found_error"}}
         status, response = self._forward("chat/completions", body)
         if status != 200:  # not an answer of the model (a rate limit, an outage): passed on, not kept
             return status, response
@@ -103,6 +100,7 @@ class Tape:
         with self._lock:
             with self.path.open("a") as f:
                 f.write(json.dumps(entry) + "\n")
+            self.answers[(key, n)] = entry
             self.seen[key] += 1
             self.served += 1
         return status, response

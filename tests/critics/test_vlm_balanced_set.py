@@ -1,6 +1,7 @@
 """The VLM critic measured on the balanced set (``benchmarks/critic_failures.py --vlm-tape``): a model's
 answers are recorded through the local tape endpoint, then replayed without the model, sample for
-sample. The model here is the local OpenAI-protocol server, answering from what it is asked."""
+sample; a tape that lacks an answer fails the replay, and recording again asks only for what it
+lacks. The model here is the local OpenAI-protocol server, answering from what it is asked."""
 
 from __future__ import annotations
 
@@ -59,3 +60,10 @@ def test_a_recorded_vlm_measurement_replays_answer_for_answer(tmp_path: Path) ->
     tape.write_text("\n".join(tape.read_text().splitlines()[:-1]) + "\n")  # one answer lost
     short = _run(cache, tape, env)
     assert short.returncode != 0 and "not on the tape" in short.stderr + short.stdout
+
+    with FakeOpenAI(model="vision-1") as model:  # recording again asks only what the tape lacks
+        model.script(*[_answer] * 200)
+        again = _run(cache, tape, {**env, "VCAGE_VLM_BASE_URL": model.base_url,
+                                   "VCAGE_VLM_MODEL": "vision-1"}, "--vlm-record")
+        assert again.returncode == 0, again.stderr
+        assert len(model.requests) == 1 and _vlm_part(again.stdout) == table
