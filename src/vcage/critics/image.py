@@ -343,12 +343,11 @@ def _pressed(obs: Observation, x: str) -> tuple[bool, str]:
     outline = hull(mx_top) if mx_top.any() else mx_top
     if not np.any(dilate(top.segmentation == ROBOT, TOUCH) & outline):
         return False, f"the hand was not over {x}"
-    cover = _button_cover(obs, x)
-    if hidden and (cover is None or _press_shortfall(obs, x) is None):
+    cover, short = _button_cover(obs, x), _press_shortfall(obs, x)
+    if hidden and (cover is None or short is None):
         return False, f"an object in front hides where the hand met {x}, and the top view cannot measure it"
     if cover is not None and cover < BUTTON_COVER:
         return False, f"the hand covered {cover:.0%} of {x}'s top (its button) at its lowest"
-    short = _press_shortfall(obs, x)
     if short is not None and short > 0:
         return False, f"the hand stopped {1000 * short:.1f} mm short of pressing {x} down its travel"
     return True, "the hand touched and covered it at its lowest"
