@@ -27,6 +27,13 @@ the smoke path (one task, two demos, a few training steps, one short evaluation 
 the loop runs, and its figures mean nothing.
 
     LP_NUM_THREADS=1 .venv/bin/python benchmarks/policy_vcage_vs_vanilla.py --work /tmp/policy-exp
+
+The three stages can also run apart (``--stage``), training on another machine: ``data`` makes the
+datasets and held-out scenes; ``train`` needs only torch and the datasets (not the simulator), so
+it runs where a GPU is (``--device cuda``; ``--budget SECONDS`` first times a short probe of all
+runs at once and picks the largest multiple of 1,000 steps that fits, the same for every run;
+``--export DIR`` writes each final checkpoint for evaluation only, with the run's timings);
+``evaluate --import DIR`` puts such checkpoints in place and rolls them out.
 """
 
 from __future__ import annotations
@@ -113,35 +120,84 @@ def run_dir(work: Path, task: str, method: str, train_seed: int) -> Path:
     return work / "runs" / slug(task) / method / f"seed{train_seed}"
 
 
-def train_config(args: argparse.Namespace, train_seed: int) -> Any:
-    from vcage.policy import TrainConfig
-
-    return TrainConfig(policy=args.policy, steps=args.steps, lr=args.lr, seed=train_seed,
-                       checkpoint_every=max(1, min(500, args.steps)))
+TRAINED = "train.json"  # in a run directory: the finished run's timings, written by the train stage
+PROBE_STEPS = 300
 
 
-def train_run(dataset: Path, run: Path, config: Any, threads: int) -> tuple[float, float, float]:
-    """One training run (resumed if interrupted): its seconds, samples per second and final loss."""
+def train_config(args: argparse.Namespace, train_seed: int, steps: int | None = None) -> Any:
+    from vcage.policy import DiffusionConfig, TrainConfig
+
+    steps = args.steps if steps is None else steps
+    diffusion = DiffusionConfig() if args.down_dims is None else \
+        DiffusionConfig(down_dims=tuple(args.down_dims))
+    return TrainConfig(policy=args.policy, steps=steps, lr=args.lr, seed=train_seed,
+                       batch_size=args.batch_size, diffusion=diffusion,
+                       checkpoint_every=max(1, min(args.checkpoint_every, steps)))
+
+
+def train_run(dataset: Path, run: Path, config: Any, threads: int,
+              device: str = "cpu") -> tuple[float, float, float]:
+    """One training run (resumed if interrupted): its seconds, samples per second and final loss,
+    also written to ``run/train.json`` once the run has reached its steps."""
     from vcage.policy.train import train
 
-    summary = train(dataset, run, config, resume=True, threads=threads, keep=2)  # 20 MB each
-    return summary.seconds, summary.samples_per_second, summary.final_loss
+    summary = train(dataset, run, config, resume=True, device=device, threads=threads, keep=2)
+    done = (summary.seconds, summary.samples_per_second, summary.final_loss)
+    if summary.start_step < summary.steps:  # a run resumed at its end measured nothing: keep the first record
+        (run / TRAINED).write_text(json.dumps({
+            "seconds": summary.seconds, "samples_per_second": summary.samples_per_second,
+            "final_loss": summary.final_loss, "steps": summary.steps, "resumed_from": summary.start_step,
+            "parameters": summary.parameters, "device": device, "batch_size": config.batch_size}, indent=1))
+    return done
 
 
-def train_all(jobs: list[tuple[Path, Path, Any]], workers: int,
-              threads: int) -> dict[Path, tuple[float, float, float]]:
+def trained_record(run: Path) -> tuple[float, float, float] | None:
+    """The timings the train stage recorded for a finished run, if it did."""
+    path = run / TRAINED
+    if not path.is_file():
+        return None
+    r = json.loads(path.read_text())
+    return float(r["seconds"]), float(r["samples_per_second"]), float(r["final_loss"])
+
+
+def train_all(jobs: list[tuple[Path, Path, Any]], workers: int, threads: int,
+              device: str = "cpu") -> dict[Path, tuple[float, float, float]]:
     """The training runs of ``jobs`` (dataset, run directory, config), ``workers`` at a time in
-    spawned processes (training is single-threaded at these sizes: processes use the cores)."""
+    spawned processes (training is single-threaded at these sizes: processes use the cores; on a
+    GPU the runs share it, each launching its own small kernels)."""
     if workers <= 1 or len(jobs) <= 1:
-        return {run: train_run(dataset, run, config, threads) for dataset, run, config in jobs}
+        return {run: train_run(dataset, run, config, threads, device) for dataset, run, config in jobs}
     import multiprocessing
     from concurrent.futures import ProcessPoolExecutor
 
     spawn = multiprocessing.get_context("spawn")
     with ProcessPoolExecutor(min(workers, len(jobs)), mp_context=spawn) as pool:
-        futures = {run: pool.submit(train_run, dataset, run, config, threads)
+        futures = {run: pool.submit(train_run, dataset, run, config, threads, device)
                    for dataset, run, config in jobs}
         return {run: future.result() for run, future in futures.items()}
+
+
+def budget_steps(jobs: list[tuple[Path, Path, Any]], budget: float, work: Path, workers: int, threads: int,
+                 device: str) -> int:
+    """The training steps per run that fit ``budget`` seconds when ``jobs`` are trained ``workers``
+    at a time: that many of them train PROBE_STEPS steps (warm-up included, so the estimate errs
+    short) into a scratch directory at the same time; the slowest sets the rate, and the runs take
+    ceil(jobs / workers) turns. A multiple of 1,000, at least 1,000."""
+    import shutil
+
+    at_once = max(1, min(workers, len(jobs)))
+    turns = -(-len(jobs) // at_once)
+    scratch = work / "probe"
+    shutil.rmtree(scratch, ignore_errors=True)
+    probes = [(dataset, scratch / f"{i}", replace(config, steps=PROBE_STEPS, checkpoint_every=PROBE_STEPS))
+              for i, (dataset, _, config) in enumerate(jobs[:at_once])]
+    timings = train_all(probes, at_once, threads, device)
+    shutil.rmtree(scratch, ignore_errors=True)
+    rate = min(PROBE_STEPS / seconds for seconds, _, _ in timings.values())
+    steps = max(1000, int(rate * budget / turns) // 1000 * 1000)
+    print(f"  probe: {at_once} runs at once, the slowest at {rate:.1f} steps/s; {len(jobs)} runs in {turns} "
+          f"turns: {steps} steps each for a {budget:.0f} s budget", flush=True)
+    return steps
 
 
 def train_and_evaluate(task: str, method: str, dataset: Path, env_config: dict[str, Any], scenes: list[int],
@@ -154,7 +210,12 @@ def train_and_evaluate(task: str, method: str, dataset: Path, env_config: dict[s
     if path.is_file():
         return dict(json.loads(path.read_text()))
     run = run_dir(work, task, method, train_seed)
-    seconds, rate, loss = trained or train_run(dataset, run, train_config(args, train_seed), args.threads)
+    trained = trained or trained_record(run)
+    if trained is None and args.stage == "evaluate":
+        raise SystemExit(f"{run} holds no finished training run: run --stage train first (or --import the "
+                         "checkpoints trained elsewhere)")
+    seconds, rate, loss = trained or train_run(dataset, run, train_config(args, train_seed), args.threads,
+                                               args.device)
     evaluation = evaluate(run, len(scenes), seed=0, max_steps=args.max_steps, env_config=env_config,
                           threads=args.threads, make_env=functools.partial(make_env, scenes=scenes),
                           workers=args.workers)
@@ -260,6 +321,43 @@ def report(results: list[dict[str, Any]], noise: dict[str, float], draws: int) -
             print(f"correlation of the per-task gap with Vanilla's label noise: {corr:+.2f}")
 
 
+def export_name(task: str, method: str, train_seed: int) -> str:
+    return f"{slug(task)}.{method}.seed{train_seed}.pt"
+
+
+def export_runs(runs: list[tuple[str, str, int]], work: Path, folder: Path) -> None:
+    """Each finished run's last checkpoint, for evaluation only, with its train-stage timings."""
+    from vcage.policy.checkpoint import export_for_evaluation, latest_checkpoint
+
+    for task, method, seed in runs:
+        run = run_dir(work, task, method, seed)
+        latest = latest_checkpoint(run)
+        if latest is None or not (run / TRAINED).is_file():
+            raise SystemExit(f"{run} has not finished training: nothing to export")
+        out = export_for_evaluation(latest, folder / export_name(task, method, seed),
+                                    trained=json.loads((run / TRAINED).read_text()))
+        print(f"  exported {out} ({out.stat().st_size / 2**20:.1f} MiB)", flush=True)
+
+
+def import_runs(runs: list[tuple[str, str, int]], work: Path, folder: Path) -> None:
+    """Put exported checkpoints where the evaluate stage finds them (a run already evaluated is left)."""
+    import shutil
+
+    from vcage.policy.checkpoint import checkpoint_path, load_checkpoint
+
+    for task, method, seed in runs:
+        source = folder / export_name(task, method, seed)
+        if not source.is_file() or result_path(work, task, method, seed).is_file():
+            continue
+        payload = load_checkpoint(source)
+        run = run_dir(work, task, method, seed)
+        target = checkpoint_path(run, int(payload["step"]))
+        target.parent.mkdir(parents=True, exist_ok=True)
+        shutil.copyfile(source, target)
+        (run / TRAINED).write_text(json.dumps(payload["trained"], indent=1))
+        print(f"  imported {source} as {target}", flush=True)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--work", type=Path, required=True, help="directory of datasets, runs and results")
@@ -270,6 +368,11 @@ def main() -> None:
     parser.add_argument("--policy", choices=("diffusion", "mlp"), default="diffusion")
     parser.add_argument("--steps", type=int, default=15000, help="training steps per checkpoint run")
     parser.add_argument("--lr", type=float, default=1e-3, help="peak learning rate")
+    parser.add_argument("--batch-size", type=int, default=64)
+    parser.add_argument("--down-dims", type=int, nargs="+", default=None,
+                        help="the diffusion U-Net's channels per level (default 32 64 128)")
+    parser.add_argument("--checkpoint-every", type=int, default=500,
+                        help="training steps between checkpoints")
     parser.add_argument("--max-steps", type=int, default=None, help="evaluation episode length cap")
     parser.add_argument("--seed", type=int, default=0, help="generation run seed (both methods)")
     parser.add_argument("--size", type=int, default=64, help="video size (the policy is state-based)")
@@ -279,6 +382,15 @@ def main() -> None:
     parser.add_argument("--fit", type=int, default=10,
                         help="also roll out each checkpoint on this many of its own training scenes (0: no)")
     parser.add_argument("--bootstrap", type=int, default=2000)
+    parser.add_argument("--stage", choices=("all", "data", "train", "evaluate"), default="all",
+                        help="run one stage only (see the module's help); default: all three")
+    parser.add_argument("--device", default="cpu", help="training device: cpu, or cuda on a GPU machine")
+    parser.add_argument("--budget", type=float, default=None,
+                        help="train stage: pick --steps to fit this many seconds (a probe times all runs)")
+    parser.add_argument("--export", type=Path, default=None,
+                        help="train stage: also write each final checkpoint, for evaluation only, here")
+    parser.add_argument("--import", dest="import_from", type=Path, default=None,
+                        help="evaluate stage: first put the checkpoints --export wrote here in place")
     parser.add_argument("--quick", action="store_true", help="smoke path: tiny everything")
     args = parser.parse_args()
     if args.quick:
@@ -286,34 +398,85 @@ def main() -> None:
         args.demos, args.eval, args.train_seeds, args.steps = 2, 1, 1, 4
         args.policy, args.max_steps, args.bootstrap, args.fit = "mlp", 20, 50, 1
     tasks = args.tasks or list(SUITE)
-    from vcage.pipeline.audit import audit
-
-    results, noise = [], {}
     t0 = time.perf_counter()
+    if args.stage == "train":
+        train_stage(tasks, args)
+        print(f"\n{len(tasks)} tasks, {args.train_seeds} training seeds, policy {args.policy} ({args.steps} "
+              f"steps) on {args.device}; {time.perf_counter() - t0:.0f} s")
+        return
+    results, noise = [], {}
     for task in tasks:
         print(f"{task}:", flush=True)
-        datasets = make_datasets(task, args.work, args.demos, args.seed, args.size, args.workers)
-        noise[task] = audit(datasets["vanilla"]).label_noise
-        scenes = solvable_scenes(task, datasets["vcage"], args.work, args.eval, base=1000 + args.seed)
-        from vcage.data import DatasetReader
-
-        env_config = DatasetReader(datasets["vcage"]).config or {}
-        pending = [(m, s) for m in METHODS for s in range(args.train_seeds)
-                   if not result_path(args.work, task, m, s).is_file()]
-        jobs = [(datasets[m], run_dir(args.work, task, m, s), train_config(args, s)) for m, s in pending]
-        trained = train_all(jobs, args.workers, args.threads)
-        for method in METHODS:
-            for train_seed in range(args.train_seeds):
-                r = train_and_evaluate(task, method, datasets[method], env_config, scenes, train_seed, args,
-                                       args.work, trained.get(run_dir(args.work, task, method, train_seed)))
-                print(f"  {method:8s} seed {train_seed}: SR {r['success_rate']:.1%} on {r['episodes']} "
-                      f"scenes, {r['train_samples_per_second']:.0f} training samples/s, "
-                      f"{r['rollouts_per_minute']:.1f} rollouts/min", flush=True)
-                results.append(r)
+        datasets, scenes, noise[task] = data_stage(task, args)
+        if args.stage != "data":
+            results += evaluate_stage(task, args, datasets, scenes)
+    if args.stage == "data":
+        return
     report(results, noise, args.bootstrap)
     print(f"\n{len(tasks)} tasks, {args.demos} demos per method, {args.train_seeds} training seeds, "
           f"{args.eval} held-out scenes, policy {args.policy} ({args.steps} steps); "
           f"{time.perf_counter() - t0:.0f} s")
+
+
+def data_stage(task: str, args: argparse.Namespace) -> tuple[dict[str, Path], list[int], float]:
+    """The task's two datasets (completed to ``--demos``), the held-out scenes, and Vanilla's label noise."""
+    from vcage.pipeline.audit import audit
+
+    datasets = make_datasets(task, args.work, args.demos, args.seed, args.size, args.workers)
+    noise = audit(datasets["vanilla"]).label_noise
+    scenes = solvable_scenes(task, datasets["vcage"], args.work, args.eval, base=1000 + args.seed)
+    print(f"  {len(scenes)} held-out scenes; Vanilla label noise {noise:.1%}", flush=True)
+    return datasets, scenes, noise
+
+
+def train_stage(tasks: list[str], args: argparse.Namespace) -> None:
+    """Every pending training run of ``tasks``, on ``--device``; reads the datasets only (no simulator)."""
+    runs = [(t, m, s) for t in tasks for m in METHODS for s in range(args.train_seeds)]
+    pending = [(t, m, s) for t, m, s in runs if not (run_dir(args.work, t, m, s) / TRAINED).is_file()]
+    datasets = {(t, m): args.work / "data" / slug(t) / m for t in tasks for m in METHODS}
+    for path in datasets.values():
+        if not (path / "meta" / "info.json").is_file():
+            raise SystemExit(f"no dataset at {path}: run --stage data first")
+    steps = args.steps
+    if pending and args.budget is not None:
+        probes = [(datasets[t, m], run_dir(args.work, t, m, s), train_config(args, s)) for t, m, s in pending]
+        steps = budget_steps(probes, args.budget, args.work, args.workers, args.threads, args.device)
+        args.steps = steps
+    jobs = [(datasets[t, m], run_dir(args.work, t, m, s), train_config(args, s, steps))
+            for t, m, s in pending]
+    trained = train_all(jobs, args.workers, args.threads, args.device)
+    for (t, m, s), (_, run, config) in zip(pending, jobs, strict=True):
+        seconds, rate, loss = trained[run]
+        print(f"  {t}: {m:8s} seed {s}: {config.steps} steps in {seconds:.0f} s ({rate:.0f} samples/s, "
+              f"batch {config.batch_size}) on {args.device}, final loss {loss:.4f}", flush=True)
+    if args.export is not None:
+        export_runs(runs, args.work, args.export)
+
+
+def evaluate_stage(task: str, args: argparse.Namespace, datasets: dict[str, Path],
+                   scenes: list[int]) -> list[dict[str, Any]]:
+    """Train what is not trained yet (unless only evaluating), then roll every run out."""
+    from vcage.data import DatasetReader
+
+    runs = [(task, m, s) for m in METHODS for s in range(args.train_seeds)]
+    if args.import_from is not None:
+        import_runs(runs, args.work, args.import_from)
+    env_config = DatasetReader(datasets["vcage"]).config or {}
+    pending = [(m, s) for _, m, s in runs if not result_path(args.work, task, m, s).is_file()
+               and trained_record(run_dir(args.work, task, m, s)) is None]
+    trained: dict[Path, tuple[float, float, float]] = {}
+    if args.stage != "evaluate":
+        jobs = [(datasets[m], run_dir(args.work, task, m, s), train_config(args, s)) for m, s in pending]
+        trained = train_all(jobs, args.workers, args.threads, args.device)
+    results = []
+    for _, method, train_seed in runs:
+        r = train_and_evaluate(task, method, datasets[method], env_config, scenes, train_seed, args,
+                               args.work, trained.get(run_dir(args.work, task, method, train_seed)))
+        print(f"  {method:8s} seed {train_seed}: SR {r['success_rate']:.1%} on {r['episodes']} "
+              f"scenes, {r['train_samples_per_second']:.0f} training samples/s, "
+              f"{r['rollouts_per_minute']:.1f} rollouts/min", flush=True)
+        results.append(r)
+    return results
 
 
 if __name__ == "__main__":

@@ -94,6 +94,20 @@ CASES = [(DATA, (2,)), (VIDEO, (2,)), (STATES, (2,)), (EXTRAS, (2,)), (EPISODES,
 PER_EPISODE = [DATA, VIDEO, STATES, EXTRAS]
 
 
+def test_a_copy_of_the_tables_alone_reads_its_frames_and_refuses_images(ds: Path) -> None:
+    shutil.rmtree(ds / "videos")  # what a training machine is given: meta/ and data/
+    with pytest.raises(CorruptDatasetError, match=r"file-000\.mp4 \(episode 0\) is missing"):
+        DatasetReader(ds)
+    tables = DatasetReader(ds, videos=False)
+    assert [tables.episode(i).length for i in range(len(tables))] == list(LENGTHS)
+    assert tables.episode(2).frames["action"].shape == (LENGTHS[2], 3)
+    with pytest.raises(DatasetError, match="tables alone"):
+        tables.video(0, CAM)
+    (ds / tables.data_path(1).relative_to(ds)).unlink()  # the tables are still checked
+    with pytest.raises(CorruptDatasetError, match=r"\(episode 1\) is missing"):
+        DatasetReader(ds, videos=False)
+
+
 def test_a_clean_dataset_verifies(ds: Path) -> None:
     full, cheap = verify(ds), check(ds)
     assert full.ok and cheap.ok, full.summary()

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import json
 import os
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -14,11 +15,12 @@ from pathlib import Path
 SCRIPT = Path(__file__).resolve().parents[2] / "benchmarks" / "policy_vcage_vs_vanilla.py"
 
 
-def run(work: Path) -> str:
-    done = subprocess.run([sys.executable, str(SCRIPT), "--work", str(work), "--quick"], capture_output=True,
-                          text=True, timeout=600, env={**os.environ, "LP_NUM_THREADS": "1"})
-    assert done.returncode == 0, done.stdout + done.stderr
-    return done.stdout
+def run(work: Path, *extra: str, env: dict[str, str] | None = None, ok: bool = True) -> str:
+    done = subprocess.run([sys.executable, str(SCRIPT), "--work", str(work), "--quick", *extra],
+                          capture_output=True, text=True, timeout=600,
+                          env={**os.environ, "LP_NUM_THREADS": "1", **(env or {})})
+    assert (done.returncode == 0) == ok, done.stdout + done.stderr
+    return done.stdout + done.stderr
 
 
 def test_the_quick_experiment_runs_end_to_end_and_resumes(tmp_path: Path) -> None:
@@ -35,3 +37,30 @@ def test_the_quick_experiment_runs_end_to_end_and_resumes(tmp_path: Path) -> Non
     assert "(0 attempts this run)" in second
     assert {p: p.stat().st_mtime_ns for p in stamps} == stamps
     assert first.split("task ")[1].split("\n\n")[0] == second.split("task ")[1].split("\n\n")[0]
+
+
+def test_the_stages_run_apart_and_training_needs_no_simulator(tmp_path: Path) -> None:
+    """Data here, training where neither the simulator nor the codec is installed (as on a GPU
+    machine), evaluation of the exported checkpoints back here in a work folder without the runs."""
+    work, exported, blocked = tmp_path / "work", tmp_path / "exported", tmp_path / "blocked"
+    for name in ("mujoco", "mink", "daqp", "av", "shapely", "trimesh"):
+        (blocked / name).mkdir(parents=True)
+        (blocked / name / "__init__.py").write_text(f"raise ImportError('{name} is not installed here')\n")
+    run(work, "--stage", "data")
+    assert not (work / "runs").exists() and not (work / "results").exists()
+    src = str(SCRIPT.parents[1] / "src")
+    trained = run(work, "--stage", "train", "--budget", "1", "--export", str(exported),
+                  env={"PYTHONPATH": os.pathsep.join([str(blocked), src])})
+    assert "probe: 1 runs at once" in trained and "2 runs in 2 turns: 1000 steps each" in trained, trained
+    assert sorted(p.name for p in exported.iterdir()) == ["press_the_bell.vanilla.seed0.pt",
+                                                          "press_the_bell.vcage.seed0.pt"]
+    shutil.rmtree(work / "runs")
+    refused = run(work, "--stage", "evaluate", ok=False)
+    assert "holds no finished training run" in refused
+    evaluated = run(work, "--stage", "evaluate", "--import", str(exported))
+    assert "Avg SR" in evaluated and "imported" in evaluated
+    for method in ("vcage", "vanilla"):
+        result = json.loads((work / "results" / "press_the_bell" / method / "seed0.json").read_text())
+        record = json.loads((work / "runs" / "press_the_bell" / method / "seed0" / "train.json").read_text())
+        assert record["steps"] == 1000 and result["train_samples_per_second"] == record["samples_per_second"]
+        assert result["episodes"] == 1

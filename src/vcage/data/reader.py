@@ -127,10 +127,15 @@ def column_to_numpy(column: pa.ChunkedArray | pa.Array) -> np.ndarray:
 
 
 class DatasetReader:
-    """Reads a LeRobot v3 dataset (vcage-written or any with the same layout) and vcage extras."""
+    """Reads a LeRobot v3 dataset (vcage-written or any with the same layout) and vcage extras.
 
-    def __init__(self, root: str | Path) -> None:
+    ``videos=False`` reads the tables alone: the videos need not be present (a copy of ``meta/`` and
+    ``data/`` carried to a machine that trains a state-based policy), and asking for images fails.
+    """
+
+    def __init__(self, root: str | Path, *, videos: bool = True) -> None:
         self.root = Path(root)
+        self.videos = videos
         self.info: dict[str, Any] = load_json(self.root / INFO_PATH)
         try:
             self._parse_info()
@@ -204,7 +209,7 @@ class DatasetReader:
 
     def _check_files(self) -> None:
         for i in range(self.num_episodes):
-            paths = [self.data_path(i)] + [self.video_path(i, key) for key in self.cameras]
+            paths = [self.data_path(i)] + [self.video_path(i, key) for key in self.cameras if self.videos]
             for path in paths:
                 if not path.is_file():
                     raise CorruptDatasetError(f"{path} (episode {i}) is missing; the dataset is corrupt")
@@ -268,6 +273,9 @@ class DatasetReader:
 
     def video(self, index: int, key: str) -> np.ndarray:
         """Decoded frames (T, H, W, 3) uint8 of one camera for one episode."""
+        if not self.videos:
+            raise DatasetError(f"{self.root} was opened for its tables alone (videos=False); open it "
+                               "again to read its videos")
         path = self.video_path(index, key)
         row = self.episode_meta(index)
         start, stop = float(row[f"videos/{key}/from_timestamp"]), float(row[f"videos/{key}/to_timestamp"])

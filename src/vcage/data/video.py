@@ -1,4 +1,8 @@
-"""MP4 encoding and decoding of RGB frame stacks with PyAV (yuv420p, one frame per 1/fps)."""
+"""MP4 encoding and decoding of RGB frame stacks with PyAV (yuv420p, one frame per 1/fps).
+
+PyAV is imported by the functions that use it, not with this module: reading a dataset's tables
+(what a state-based policy trains on) works where the codec library is not installed.
+"""
 
 from __future__ import annotations
 
@@ -8,7 +12,6 @@ from dataclasses import dataclass
 from fractions import Fraction
 from pathlib import Path
 
-import av
 import numpy as np
 
 from vcage.errors import CorruptDatasetError, DatasetError
@@ -32,6 +35,7 @@ ENCODER_OPTIONS: dict[str, dict[str, str]] = {
 
 def available_encoders() -> list[str]:
     """The preferred encoders this PyAV wheel can actually open for writing, best first."""
+    import av
     found = []
     for name in ENCODER_OPTIONS:
         if name not in av.codecs_available:
@@ -57,6 +61,7 @@ def choose_encoder() -> str:
 
 def codec_name(encoder: str) -> str:
     """The format name of an encoder's output (``libsvtav1`` -> ``av1``), as LeRobot records it."""
+    import av
     return str(av.Codec(encoder, "w").canonical_name)
 
 
@@ -71,6 +76,7 @@ def check_frame_size(height: int, width: int, key: str = "video") -> None:
 
 def encode_video(path: Path, frames: np.ndarray, fps: int, encoder: str) -> None:
     """Write ``frames`` (T,H,W,3 uint8) to ``path`` as MP4; frame i has timestamp i/fps."""
+    import av
     if frames.ndim != 4 or frames.shape[-1] != 3 or frames.dtype != np.uint8 or len(frames) == 0:
         raise DatasetError(f"video frames must be (T,H,W,3) uint8 with T >= 1, got {frames.dtype} "
                            f"{frames.shape}")
@@ -94,6 +100,7 @@ def encode_video(path: Path, frames: np.ndarray, fps: int, encoder: str) -> None
 
 def decode_video(path: Path) -> tuple[np.ndarray, np.ndarray]:
     """Decode an MP4 to (frames (T,H,W,3) uint8, timestamps (T,) float64 seconds)."""
+    import av
     frames: list[np.ndarray] = []
     times: list[float] = []
     try:
@@ -158,6 +165,7 @@ def probe_video(path: Path) -> Probe:
     The count is the stream's ``nb_frames`` from the MP4 index; where the container does not record
     it, the packets are counted (read, not decoded).
     """
+    import av
     check_boxes(path)
     try:
         with av.open(str(path)) as container:
@@ -175,6 +183,7 @@ def decode_times(path: Path) -> np.ndarray:
 
     Costs a full decode; CorruptDatasetError if the stream cannot be decoded.
     """
+    import av
     times: list[float] = []
     try:
         with av.open(str(path)) as container:
@@ -196,6 +205,7 @@ def concat_videos(sources: list[tuple[Path, int]], out: Path, fps: int) -> None:
     a time); the sources must share codec, size and time base. CorruptDatasetError names a source
     that cannot be read or has fewer than ``n`` frames; DatasetError one that does not match.
     """
+    import av
     frame_seconds = Fraction(1, fps)
     with av.open(str(out), "w", format="mp4") as container:
         target: av.VideoStream | None = None
@@ -237,6 +247,7 @@ def concat_videos(sources: list[tuple[Path, int]], out: Path, fps: int) -> None:
 def decode_window(path: Path, start: float, stop: float, fps: int) -> np.ndarray:
     """Decode the frames of an MP4 with timestamps in ``[start, stop)`` (half a frame of tolerance),
     seeking to the key frame before ``start`` rather than decoding the file from its beginning."""
+    import av
     half = 0.5 / fps
     frames: list[np.ndarray] = []
     try:

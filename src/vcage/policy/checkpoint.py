@@ -24,6 +24,9 @@ FORMAT, FORMAT_VERSION = "vcage-policy", 1
 CHECKPOINTS = "checkpoints"
 NAME = re.compile(r"^step-(\d+)\.pt$")
 REQUIRED = ("config", "dataset", "obs_features", "action_feature", "normalization", "step", "model", "ema")
+# What only resuming reads: an exported checkpoint (export_for_evaluation) leaves these out.
+RESUME_STATE = ("model", "optimizer", "rng", "sampler")
+EVALUATION_ONLY = "evaluation_only"
 
 
 def checkpoint_path(out: Path, step: int) -> Path:
@@ -112,7 +115,8 @@ def load_checkpoint(path: str | Path) -> dict[str, Any]:
         raise CheckpointError(f"{path} has checkpoint format {payload.get('format_version')!r}; this vcage "
                               f"reads format {FORMAT_VERSION}: evaluate it with the vcage that wrote it "
                               f"({payload.get('vcage_version', 'unknown')}) or train again")
-    missing = [k for k in REQUIRED if k not in payload]
+    required = [k for k in REQUIRED if not (payload.get(EVALUATION_ONLY) and k in RESUME_STATE)]
+    missing = [k for k in required if k not in payload]
     if missing:
         raise CheckpointError(f"{path} lacks {', '.join(missing)}; it is damaged: train again")
     if isinstance(payload["config"], dict) and "rotations" not in payload["config"]:
@@ -120,3 +124,17 @@ def load_checkpoint(path: str | Path) -> dict[str, Any]:
         payload["config"] = {**payload["config"], "rotations": "quaternion"}
     payload["path"] = str(path)
     return payload
+
+
+def export_for_evaluation(source: str | Path, destination: str | Path, **extra: Any) -> Path:
+    """Copy a checkpoint with what evaluation reads (configuration, dataset record, normalisation,
+    EMA weights, loss history) and without what only resuming reads (the raw weights, the
+    optimiser, the generators and the sampler): about a quarter of the size, for moving a policy
+    trained elsewhere (a GPU machine) to where it is evaluated. ``extra`` entries (plain data, such
+    as the training run's timings) are stored beside. The copy cannot resume training."""
+    payload = load_checkpoint(source)
+    kept = {k: v for k, v in payload.items()
+            if k not in RESUME_STATE and k not in ("format", "format_version", "path")}
+    destination = Path(destination)
+    save_checkpoint(destination, {**kept, **extra, EVALUATION_ONLY: True})
+    return destination

@@ -109,7 +109,7 @@ def load_training_data(root: str | Path, config: TrainConfig) -> TrainingData:
         DatasetError: not a dataset, fewer than two episodes, or non-finite values.
         MissingFeatureError: a needed feature is absent (the message names the back-fill command).
     """
-    reader = DatasetReader(root)
+    reader = DatasetReader(root, videos=False)  # the tables alone: a copy without videos/ trains the same
     if reader.num_episodes < MIN_EPISODES:
         raise DatasetError(f"the dataset {reader.root} has {reader.num_episodes} episode(s); training needs "
                            f"at least {MIN_EPISODES} (`vcage generate ... --out {reader.root} --episodes N "

@@ -23,8 +23,13 @@ class Ema:
     @torch.no_grad()
     def update(self, model: nn.Module) -> None:
         decay = self.decay()
-        for averaged, current in zip(self.model.parameters(), model.parameters(), strict=True):
-            averaged.mul_(decay).add_(current.detach(), alpha=1 - decay)
+        averaged: list[torch.Tensor] = list(self.model.parameters())
+        current: list[torch.Tensor] = [p.detach() for p in model.parameters()]
+        if len(averaged) != len(current):
+            raise ValueError(f"the EMA holds {len(averaged)} parameters, the model {len(current)}")
+        # one kernel per operation for all parameters (on a GPU, a loop launches two per parameter)
+        torch._foreach_mul_(averaged, decay)
+        torch._foreach_add_(averaged, current, alpha=1 - decay)
         for kept, buffer in zip(self.model.buffers(), model.buffers(), strict=True):
             kept.copy_(buffer)
         self.updates += 1

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import contextlib
 import math
+import os
 import time
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, fields
@@ -23,6 +24,7 @@ import torch
 from vcage import __version__
 from vcage.errors import ConfigError
 from vcage.policy.checkpoint import (
+    EVALUATION_ONLY,
     checkpoint_path,
     latest_checkpoint,
     load_checkpoint,
@@ -57,10 +59,17 @@ class TrainSummary:
 
 
 @contextlib.contextmanager
-def deterministic(threads: int | None) -> Iterator[None]:
-    """Deterministic kernels (and ``threads`` intra-op threads, if given) for the duration."""
+def deterministic(threads: int | None, device: torch.device | None = None) -> Iterator[None]:
+    """Deterministic kernels (and ``threads`` intra-op threads, if given) for the duration.
+
+    On a GPU, cuBLAS is given the fixed workspace its deterministic mode needs, and a kernel with no
+    deterministic version warns instead of stopping the run: results are reproducible on the CPU
+    (what the tests check), and on a GPU as far as its kernels allow."""
     was, old_threads = torch.are_deterministic_algorithms_enabled(), torch.get_num_threads()
-    torch.use_deterministic_algorithms(True)
+    on_gpu = device is not None and device.type == "cuda"
+    if on_gpu:
+        os.environ.setdefault("CUBLAS_WORKSPACE_CONFIG", ":4096:8")
+    torch.use_deterministic_algorithms(True, warn_only=on_gpu)
     if threads is not None:
         torch.set_num_threads(threads)
     try:
@@ -171,6 +180,9 @@ def _resume_from(out: Path, config: TrainConfig, resume: bool) -> dict[str, Any]
         raise PolicyError(f"{out} already holds a training run (last checkpoint {latest.name}); pass "
                           "--resume to continue it, or choose another --out")
     payload = load_checkpoint(latest)
+    if payload.get(EVALUATION_ONLY):
+        raise CheckpointError(f"{latest} was exported for evaluation (it has no optimiser state) and cannot "
+                              f"resume training; train again into another --out")
     diffs = config_differences(TrainConfig.from_dict(payload["config"]), config)
     if diffs:
         raise ConfigError(f"--resume continues the run in {out} with its own configuration, which differs: "
@@ -204,7 +216,7 @@ def train(dataset: str | Path, out: str | Path, config: TrainConfig, *, resume: 
     else:
         normalization = {"obs": Normalizer.fit(data.obs, config.obs_norm),
                          "action": Normalizer.fit(data.action, "min_max")}
-    with deterministic(threads):
+    with deterministic(threads, where):
         run = Run(data, config, normalization, where)
         if saved is not None:
             run.restore(saved)
