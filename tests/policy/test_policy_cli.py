@@ -51,6 +51,20 @@ def test_train_then_evaluate_in_the_datasets_environment(generated: Path, tmp_pa
     assert record["checkpoint"].endswith("step-00000008.pt") and len(record["subtask_progress"]) == 1
 
 
+def test_sizes_are_set_from_the_cli_and_an_exported_copy_evaluates(generated: Path, tmp_path: Path) -> None:
+    out, moved = tmp_path / "run", tmp_path / "moved.pt"
+    result = RUN.invoke(app, ["train", str(generated), "--out", str(out), "--steps", "2", "--batch-size", "4",
+                              "--down-dims", "16,32", "--threads", "1", "--export", str(moved)])
+    assert result.exit_code == 0, result.output
+    assert "exported for evaluation" in flat(result.output)
+    copy = load_checkpoint(moved)
+    assert tuple(copy["config"]["diffusion"]["down_dims"]) == (16, 32) and copy["evaluation_only"] is True
+    evaluated = RUN.invoke(app, ["evaluate", str(moved), "--episodes", "1", "--max-steps", "8"])
+    assert evaluated.exit_code == 0, evaluated.output
+    bad = RUN.invoke(app, ["train", str(generated), "--out", str(tmp_path / "other"), "--down-dims", "16,x"])
+    assert bad.exit_code == 2 and "comma-separated integers" in flat(bad.output)
+
+
 def test_bad_input_exits_2_with_the_reason(generated: Path, tmp_path: Path) -> None:
     missing = RUN.invoke(app, ["evaluate", str(tmp_path / "nothing"), "--episodes", "1"])
     assert missing.exit_code == 2 and missing.output.startswith("error:")

@@ -10,6 +10,7 @@ from rich.table import Table
 
 from vcage.cli._app import app, console
 from vcage.cli.errors import cli_errors
+from vcage.errors import ConfigError
 
 
 @app.command("train")
@@ -32,6 +33,10 @@ def train_cmd(
                                              "(default: all; each is about 20 MB at the default sizes)"),
         resume: bool = typer.Option(False, help="continue the run in OUT from its last checkpoint (only "
                                     "--steps may change)"),
+        down_dims: str = typer.Option(None, help="the diffusion U-Net's channels per level, comma-separated "
+                                      "(default 32,64,128)"),
+        export: Path = typer.Option(None, help="also write the final checkpoint for evaluation only (EMA "
+                                    "weights, no optimiser state: about a quarter of the size) to this file"),
         device: str = typer.Option("cpu", help="cpu, or cuda when a GPU is present"),
         threads: int = typer.Option(None, min=1, help="torch CPU threads (default: torch's choice)")) -> None:
     """Train a policy on DATASET: deterministic on the CPU given --seed, resumable with --resume."""
@@ -46,7 +51,15 @@ def train_cmd(
                              if obs else None}
     given = {k: v for k, v in given.items() if v is not None}
     base = stored_config(out) if resume else None
-    config = TrainConfig.from_dict({**(base.to_dict() if base else {}), **given})
+    merged = {**(base.to_dict() if base else {}), **given}
+    if down_dims:
+        try:
+            dims = [int(d) for d in down_dims.split(",") if d.strip()]
+        except ValueError:
+            raise ConfigError(f"--down-dims takes comma-separated integers, e.g. 48,96,192; got "
+                              f"{down_dims!r}") from None
+        merged["diffusion"] = {**merged.get("diffusion", {}), "down_dims": dims}
+    config = TrainConfig.from_dict(merged)
     bar = Progress(TextColumn("{task.description}"), BarColumn(), TextColumn("{task.completed}/{task.total}"),
                    TimeElapsedColumn(), TimeRemainingColumn(), console=console)
     job = bar.add_task(f"training {config.policy}", total=config.steps)
@@ -74,4 +87,8 @@ def train_cmd(
     table.add_row("training time", f"{summary.seconds:.1f} s")
     table.add_row("parameters", f"{summary.parameters:,}")
     table.add_row("checkpoint", str(summary.checkpoint))
+    if export is not None:
+        from vcage.policy.checkpoint import export_for_evaluation
+
+        table.add_row("exported for evaluation", str(export_for_evaluation(summary.checkpoint, export)))
     console.print(table)
