@@ -413,9 +413,11 @@ def main() -> None:
     if args.stage == "data":
         return
     report(results, noise, args.bootstrap)
+    found = (re.search(r"step-(\d+)", str(r["checkpoint"])) for r in results)
+    steps = sorted({int(m.group(1)) for m in found if m})
     print(f"\n{len(tasks)} tasks, {args.demos} demos per method, {args.train_seeds} training seeds, "
-          f"{args.eval} held-out scenes, policy {args.policy} ({args.steps} steps); "
-          f"{time.perf_counter() - t0:.0f} s")
+          f"{args.eval} held-out scenes, policy {args.policy} "
+          f"({', '.join(map(str, steps)) or args.steps} steps); {time.perf_counter() - t0:.0f} s")
 
 
 def data_stage(task: str, args: argparse.Namespace) -> tuple[dict[str, Path], list[int], float]:
