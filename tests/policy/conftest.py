@@ -97,3 +97,15 @@ def generated(tmp_path_factory: pytest.TempPathFactory) -> Path:
                                       "--out", str(out)])
     assert result.exit_code == 0, result.output
     return out
+
+
+SIMULATOR_AND_CODEC = ("mujoco", "mink", "daqp", "av", "shapely", "trimesh")
+
+
+def blocked_modules(folder: Path, names: tuple[str, ...] = SIMULATOR_AND_CODEC) -> Path:
+    """A folder that, first on PYTHONPATH, makes importing each of ``names`` fail as if it were not
+    installed (what a machine that only trains has)."""
+    for name in names:
+        (folder / name).mkdir(parents=True, exist_ok=True)
+        (folder / name / "__init__.py").write_text(f"raise ImportError('{name} is not installed here')\n")
+    return folder

@@ -12,6 +12,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+from conftest import blocked_modules
+
 SCRIPT = Path(__file__).resolve().parents[2] / "benchmarks" / "policy_vcage_vs_vanilla.py"
 
 
@@ -42,10 +44,7 @@ def test_the_quick_experiment_runs_end_to_end_and_resumes(tmp_path: Path) -> Non
 def test_the_stages_run_apart_and_training_needs_no_simulator(tmp_path: Path) -> None:
     """Data here, training where neither the simulator nor the codec is installed (as on a GPU
     machine), evaluation of the exported checkpoints back here in a work folder without the runs."""
-    work, exported, blocked = tmp_path / "work", tmp_path / "exported", tmp_path / "blocked"
-    for name in ("mujoco", "mink", "daqp", "av", "shapely", "trimesh"):
-        (blocked / name).mkdir(parents=True)
-        (blocked / name / "__init__.py").write_text(f"raise ImportError('{name} is not installed here')\n")
+    work, exported, blocked = tmp_path / "work", tmp_path / "exported", blocked_modules(tmp_path / "blocked")
     run(work, "--stage", "data")
     assert not (work / "runs").exists() and not (work / "results").exists()
     src = str(SCRIPT.parents[1] / "src")

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 import torch
 
-from conftest import tiny
+from conftest import blocked_modules, tiny
 from vcage.policy.checkpoint import EVALUATION_ONLY, export_for_evaluation, load_checkpoint
 from vcage.policy.errors import CheckpointError
 from vcage.policy.inference import PolicyRunner
@@ -58,10 +58,7 @@ def test_an_exported_checkpoint_missing_its_ema_is_refused(dataset: Path, tmp_pa
 
 
 def test_training_needs_neither_the_simulator_nor_the_video_codec(dataset: Path, tmp_path: Path) -> None:
-    blocked = tmp_path / "blocked"
-    for name in ("mujoco", "mink", "daqp", "av", "shapely", "trimesh"):
-        (blocked / name).mkdir(parents=True)
-        (blocked / name / "__init__.py").write_text(f"raise ImportError('{name} is not installed here')\n")
+    blocked = blocked_modules(tmp_path / "blocked")
     code = ("import sys; from vcage.policy.train import train; from vcage.policy.config import TrainConfig, "
             "DiffusionConfig; c = TrainConfig(steps=3, batch_size=8, checkpoint_every=3, "
             "diffusion=DiffusionConfig(down_dims=(16, 32), n_groups=4, step_embed_dim=16)); "
