@@ -1,0 +1,65 @@
+"""Where a policy rollout's time goes: the policy's inference against the environment's step.
+
+Rolls a checkpoint out in the evaluation environment of the dataset it was trained on, on one
+thread, and prints per control step the milliseconds spent in ``PolicyRunner.act`` (a diffusion
+policy samples a chunk with its DDIM steps once every ``n_action_steps`` steps) and in
+``env.step`` (physics, control and the oracle's progress), and the environment's reset.
+
+    LP_NUM_THREADS=1 .venv/bin/python benchmarks/policy_rollout.py RUN --episodes 2 --max-steps 400
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+from pathlib import Path
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("checkpoint", type=Path, help="a checkpoint file or a training run's directory")
+    parser.add_argument("--episodes", type=int, default=2)
+    parser.add_argument("--max-steps", type=int, default=400, help="control steps per episode at most")
+    parser.add_argument("--seed", type=int, default=0, help="evaluation seed")
+    args = parser.parse_args()
+
+    import torch
+
+    from vcage.pipeline.evaluation import make_env
+    from vcage.policy.checkpoint import load_checkpoint
+    from vcage.policy.evaluate import episode_noise_seed
+    from vcage.policy.inference import PolicyRunner
+
+    torch.set_num_threads(1)
+    checkpoint = load_checkpoint(args.checkpoint)
+    env = make_env(checkpoint["dataset"]["config"], max_steps=args.max_steps)
+    runner = PolicyRunner(checkpoint)
+    policy = stepping = resetting = 0.0
+    steps = 0
+    for episode in range(args.episodes):
+        runner.reset(episode_noise_seed(args.seed, episode))
+        t = time.perf_counter()
+        obs, _ = env.reset(seed=args.seed, options={"episode": episode})
+        resetting += time.perf_counter() - t
+        done = False
+        while not done:
+            t0 = time.perf_counter()
+            action = runner.act(obs)
+            t1 = time.perf_counter()
+            obs, _, terminated, truncated, _ = env.step(action)
+            stepping += time.perf_counter() - t1
+            policy += t1 - t0
+            steps += 1
+            done = terminated or truncated
+    config = checkpoint["config"]
+    total = policy + stepping + resetting
+    print(f"{args.episodes} episodes, {steps} control steps, policy {config['policy']} "
+          f"(step {checkpoint['step']}, down_dims {config['diffusion']['down_dims']}, "
+          f"{config['diffusion']['inference_steps']} DDIM steps per chunk of {config['n_action_steps']})")
+    print(f"  policy  {1000 * policy / steps:6.2f} ms per control step ({policy / total:.0%})")
+    print(f"  env     {1000 * stepping / steps:6.2f} ms per control step ({stepping / total:.0%})")
+    print(f"  reset   {resetting / args.episodes:6.2f} s per episode ({resetting / total:.0%})")
+
+
+if __name__ == "__main__":
+    main()
