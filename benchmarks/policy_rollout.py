@@ -13,6 +13,7 @@ from __future__ import annotations
 import argparse
 import time
 from pathlib import Path
+from typing import Any
 
 
 def main() -> None:
@@ -21,6 +22,9 @@ def main() -> None:
     parser.add_argument("--episodes", type=int, default=2)
     parser.add_argument("--max-steps", type=int, default=400, help="control steps per episode at most")
     parser.add_argument("--seed", type=int, default=0, help="evaluation seed")
+    parser.add_argument("--batch-sizes", type=int, nargs="*", default=[1, 8, 32],
+                        help="also time the policy's network alone at these batch sizes (what sampling "
+                             "several episodes' chunks at once would cost)")
     args = parser.parse_args()
 
     import torch
@@ -59,6 +63,30 @@ def main() -> None:
     print(f"  policy  {1000 * policy / steps:6.2f} ms per control step ({policy / total:.0%})")
     print(f"  env     {1000 * stepping / steps:6.2f} ms per control step ({stepping / total:.0%})")
     print(f"  reset   {resetting / args.episodes:6.2f} s per episode ({resetting / total:.0%})")
+    if args.batch_sizes and config["policy"] == "diffusion":
+        network_passes(runner, args.batch_sizes)
+
+
+def network_passes(runner: Any, sizes: list[int], repeats: int = 50) -> None:
+    """Milliseconds per U-Net pass, and per sample, at each batch size (random inputs)."""
+    import torch
+
+    unet = runner.model.unet
+    horizon, action_dim = runner.config.horizon, runner.model.action_dim
+    cond_dim = runner.encoder.size * runner.config.n_obs_steps
+    generator = torch.Generator().manual_seed(0)
+    for size in sizes:
+        x = torch.randn(size, horizon, action_dim, generator=generator)
+        t = torch.randint(0, 100, (size,), generator=generator)
+        cond = torch.randn(size, cond_dim, generator=generator)
+        with torch.no_grad():
+            for _ in range(5):
+                unet(x, t, cond)
+            start = time.perf_counter()
+            for _ in range(repeats):
+                unet(x, t, cond)
+            ms = 1000 * (time.perf_counter() - start) / repeats
+        print(f"  network alone, batch {size:3d}: {ms:6.2f} ms per pass, {ms / size:6.3f} ms per sample")
 
 
 if __name__ == "__main__":
