@@ -22,6 +22,9 @@ def main() -> None:
     parser.add_argument("--episodes", type=int, default=2)
     parser.add_argument("--max-steps", type=int, default=400, help="control steps per episode at most")
     parser.add_argument("--seed", type=int, default=0, help="evaluation seed")
+    parser.add_argument("--compare-batch", type=int, default=0,
+                        help="also evaluate --episodes episodes with vcage's evaluate at batch 1 and at "
+                             "this batch, and compare rollouts per minute and outcomes (0: no)")
     parser.add_argument("--batch-sizes", type=int, nargs="*", default=[1, 8, 32],
                         help="also time the policy's network alone at these batch sizes (what sampling "
                              "several episodes' chunks at once would cost)")
@@ -65,6 +68,22 @@ def main() -> None:
     print(f"  reset   {resetting / args.episodes:6.2f} s per episode ({resetting / total:.0%})")
     if args.batch_sizes and config["policy"] == "diffusion":
         network_passes(runner, args.batch_sizes)
+    if args.compare_batch:
+        compare_batch(args.checkpoint, args.episodes, args.max_steps, args.seed, args.compare_batch)
+
+
+def compare_batch(checkpoint: Path, episodes: int, max_steps: int, seed: int, batch: int) -> None:
+    """The same episodes evaluated one at a time and in blocks of ``batch``, in one process."""
+    from vcage.policy.evaluate import evaluate
+
+    runs = {b: evaluate(checkpoint, episodes, seed=seed, max_steps=max_steps, threads=1, batch=b)
+            for b in (1, batch)}
+    for b, run in runs.items():
+        print(f"  evaluate --batch {b:2d}: {run.rollouts_per_minute:6.1f} rollouts/min, "
+              f"{run.successes}/{len(run.episodes)} successes, mean progress {run.mean_progress:.2f}")
+    same = sum(a == b for a, b in zip(runs[1].episodes, runs[batch].episodes, strict=True))
+    print(f"  {same} of {episodes} episodes identical (steps, subtasks, outcome) at batch 1 and {batch}; "
+          f"speed-up {runs[batch].rollouts_per_minute / runs[1].rollouts_per_minute:.2f}x")
 
 
 def network_passes(runner: Any, sizes: list[int], repeats: int = 50) -> None:

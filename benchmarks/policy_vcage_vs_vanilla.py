@@ -218,7 +218,7 @@ def train_and_evaluate(task: str, method: str, dataset: Path, env_config: dict[s
                                                args.device)
     evaluation = evaluate(run, len(scenes), seed=0, max_steps=args.max_steps, env_config=env_config,
                           threads=args.threads, make_env=functools.partial(make_env, scenes=scenes),
-                          workers=args.workers)
+                          workers=args.workers, batch=args.eval_batch)
     fit = None
     if args.fit:  # the same checkpoint on scenes of its own training episodes: does it fit its data?
         from vcage.policy.checkpoint import load_checkpoint
@@ -226,10 +226,11 @@ def train_and_evaluate(task: str, method: str, dataset: Path, env_config: dict[s
 
         own = training_scenes(load_checkpoint(run), args.fit)
         fit = evaluate(run, len(own), seed=0, max_steps=args.max_steps, env_config=env_config,
-                       threads=args.threads, scenes=own, workers=args.workers)
+                       threads=args.threads, scenes=own, workers=args.workers, batch=args.eval_batch)
     out = evaluation.to_dict() | {"task": task, "method": method, "train_seed": train_seed,
                                   "fit": None if fit is None else {"episodes": len(fit.episodes),
                                                                    "successes": fit.successes},
+                                  "eval_batch": args.eval_batch,
                                   "train_seconds": seconds, "train_samples_per_second": rate,
                                   "final_loss": loss}
     path.parent.mkdir(parents=True, exist_ok=True)
@@ -379,6 +380,9 @@ def main() -> None:
     parser.add_argument("--threads", type=int, default=1, help="torch threads per process")
     parser.add_argument("--workers", type=int, default=1,
                         help="processes for generation, training runs and rollouts (same results as one)")
+    parser.add_argument("--eval-batch", type=int, default=1,
+                        help="evaluation episodes stepped together, chunks sampled as one batch (faster; "
+                             "results depend on it)")
     parser.add_argument("--fit", type=int, default=10,
                         help="also roll out each checkpoint on this many of its own training scenes (0: no)")
     parser.add_argument("--bootstrap", type=int, default=2000)

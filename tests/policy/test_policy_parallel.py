@@ -87,3 +87,47 @@ class _NoIndex(gym.Wrapper):
     @property
     def unwrapped(self) -> gym.Env:
         return self
+
+
+def test_batched_blocks_give_the_same_episodes_from_one_worker_or_two(generated: Path,
+                                                                      diffusion_run: Path) -> None:
+    one = evaluate(diffusion_run, 5, seed=7, max_steps=6, threads=1, batch=2)  # blocks [0, 1] [2, 3] [4]
+    done: list[int] = []
+    two = evaluate(diffusion_run, 5, seed=7, max_steps=6, workers=2, batch=2,
+                   progress=lambda k, n, r: done.append(k))
+    assert two.episodes == one.episodes and sorted(done) == [1, 2, 3, 4, 5]
+    assert [e.scene_seed for e in one.episodes] == [eval_seed(7, k, 0) for k in range(5)]
+    alone = evaluate(diffusion_run, 5, seed=7, max_steps=6, threads=1)
+    assert [e.scene_seed for e in alone.episodes] == [e.scene_seed for e in one.episodes]
+    assert all(e.steps == 6 for e in one.episodes)  # every episode of a block runs to its own end
+
+
+def test_a_block_samples_each_episodes_chunk_from_its_own_noise(generated: Path, diffusion_run: Path) -> None:
+    """Stepped beside another episode, an episode's actions are its actions alone (to float32
+    rounding of the batched arithmetic), not those of its neighbour's noise."""
+    from vcage.policy.evaluate import rollout_block
+
+    config = DatasetReader(generated).config
+    payload = load_checkpoint(diffusion_run)
+    solo = Recorder(make_env(config, seed=3, max_steps=9))
+    rollout(PolicyRunner(payload), solo, 3, episode=1)
+    pair = [Recorder(make_env(config, seed=3, max_steps=9)) for _ in range(2)]
+    results = rollout_block([PolicyRunner(payload), PolicyRunner(payload)], pair, 3, [0, 1])
+    np.testing.assert_allclose(np.stack(pair[1].actions), np.stack(solo.actions), atol=1e-4)
+    assert not np.allclose(np.stack(pair[0].actions), np.stack(pair[1].actions), atol=1e-3)
+    assert [r.scene_seed for r in results] == [eval_seed(3, 0, 0), eval_seed(3, 1, 0)]
+    for env in (solo, *pair):
+        env.close()
+
+
+def test_batches_need_an_environment_that_starts_episodes_by_index(diffusion_run: Path,
+                                                                   generated: Path) -> None:
+    config = DatasetReader(generated).config
+
+    def opaque(cfg: dict[str, Any], *, seed: int, max_steps: int | None = None) -> gym.Env:
+        return _NoIndex(make_env(cfg, seed=seed, max_steps=max_steps))
+
+    with pytest.raises(PolicyError, match="--batch 1"):
+        evaluate(diffusion_run, 2, env_config=config, make_env=opaque, batch=2, max_steps=4)
+    with pytest.raises(PolicyError, match="--batch must be a positive integer"):
+        evaluate(diffusion_run, 2, batch=0)

@@ -62,11 +62,12 @@ def test_the_runner_predicts_every_eight_steps_from_a_two_frame_window(checkpoin
     seen: list[torch.Tensor] = []
     chunk = torch.arange(16 * 8, dtype=torch.float32).reshape(1, 16, 8) / 100
 
-    def predict(obs: torch.Tensor, generator: torch.Generator) -> torch.Tensor:
+    def predict_from(obs: torch.Tensor, noise: torch.Tensor) -> torch.Tensor:
         seen.append(obs.clone())
+        assert noise.shape == (1, 16, 8)
         return chunk
 
-    runner.model.predict = predict  # type: ignore[method-assign]
+    runner.model.predict_from = predict_from  # type: ignore[method-assign]
     env = CountingEnv(set())
     obs, _ = env.reset()
     actions = []

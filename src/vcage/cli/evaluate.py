@@ -27,6 +27,8 @@ def evaluate_cmd(
         threads: int = typer.Option(None, min=1, help="torch CPU threads (default: torch's choice; 1 per "
                                     "worker with --workers)"),
         workers: int = typer.Option(1, min=1, help="processes sharing the episodes (same results as one)"),
+        batch: int = typer.Option(1, min=1, help="episodes stepped together, their chunks sampled as one "
+                                  "batch: faster on a CPU; results depend on it (not on --workers)"),
         training_scenes: bool = typer.Option(False, help="roll out on the scenes of the training dataset's "
                                              "first --episodes episodes instead of held-out ones: does the "
                                              "policy reproduce its own demonstrations?"),
@@ -65,7 +67,8 @@ def evaluate_cmd(
 
     try:
         result = evaluate(checkpoint, episodes, seed=seed, max_steps=max_steps, env_config=env_config,
-                          device=device, threads=threads, progress=update, workers=workers, scenes=scenes)
+                          device=device, threads=threads, progress=update, workers=workers, scenes=scenes,
+                          batch=batch)
     finally:
         if bar.live.is_started:
             bar.stop()

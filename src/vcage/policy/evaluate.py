@@ -22,7 +22,7 @@ import torch
 from vcage.policy.checkpoint import load_checkpoint
 from vcage.policy.devices import torch_device
 from vcage.policy.errors import EnvironmentMismatchError, PolicyError
-from vcage.policy.inference import PolicyRunner
+from vcage.policy.inference import PolicyRunner, act_together
 from vcage.policy.metrics import subtask_reached, wilson_interval
 
 EnvFactory = Callable[..., gym.Env]  # (config, *, seed, max_steps) -> env, as make_env
@@ -125,6 +125,39 @@ def episode_noise_seed(seed: int, episode: int) -> int:
     return int(np.random.SeedSequence([seed, episode]).generate_state(1)[0])
 
 
+def rollout_block(runners: Sequence[PolicyRunner], envs: Sequence[gym.Env], seed: int,
+                  episodes: Sequence[int]) -> list[EpisodeResult]:
+    """Episodes ``episodes`` stepped together, one per runner and environment: the runners whose
+    queue is empty sample their chunks as one batch (:func:`act_together`), and an episode that ends
+    leaves the batch. The outcome of an episode depends only on the block it is in (the others'
+    observations change what is computed beside it, not the arithmetic of its own chunk, beyond the
+    last bits that a batch's size can change)."""
+    obs = []
+    for runner, env, k in zip(runners, envs, episodes, strict=True):
+        runner.reset(episode_noise_seed(seed, k))
+        obs.append(env.reset(seed=seed, options={"episode": k})[0])
+    results: list[EpisodeResult | None] = [None] * len(episodes)
+    steps = [0] * len(episodes)
+    live = list(range(len(episodes)))
+    while live:
+        actions = act_together([runners[i] for i in live], [obs[i] for i in live])
+        still = []
+        for i, action in zip(live, actions, strict=True):
+            obs[i], _, terminated, truncated, info = envs[i].step(action)
+            steps[i] += 1
+            if terminated or truncated:
+                results[i] = episode_result(info, steps[i])
+            else:
+                still.append(i)
+        live = still
+    return [r for r in results if r is not None]
+
+
+def blocks(episodes: int, batch: int) -> list[list[int]]:
+    """Episodes 0..episodes-1 in consecutive blocks of ``batch`` (the last may be shorter)."""
+    return [list(range(start, min(start + batch, episodes))) for start in range(0, episodes, batch)]
+
+
 def rollout(runner: PolicyRunner, env: gym.Env, seed: int | None = None,
             episode: int | None = None) -> EpisodeResult:
     """One episode of ``runner`` in ``env`` (reset with ``seed``, if given), to its end.
@@ -144,6 +177,11 @@ def rollout(runner: PolicyRunner, env: gym.Env, seed: int | None = None,
     while not (terminated or truncated):
         obs, _, terminated, truncated, info = env.step(runner.act(obs))
         steps += 1
+    return episode_result(info, steps)
+
+
+def episode_result(info: Mapping[str, Any], steps: int) -> EpisodeResult:
+    """What an episode that ended with ``info`` after ``steps`` steps achieved."""
     return EpisodeResult(bool(info.get("success", False)), int(info.get("subtasks_done", 0)),
                          int(info.get("subtasks", 1)), float(info.get("progress", 0.0)), steps,
                          info.get("scene_seed"))
@@ -180,7 +218,7 @@ def evaluate(checkpoint: str | Path, episodes: int, *, seed: int = 0, max_steps:
              env_config: dict[str, Any] | None = None, device: str = "cpu", threads: int | None = None,
              make_env: EnvFactory | None = None,
              progress: Callable[[int, int, EpisodeResult], None] | None = None,
-             workers: int = 1, scenes: Sequence[int] | None = None) -> Evaluation:
+             workers: int = 1, scenes: Sequence[int] | None = None, batch: int = 1) -> Evaluation:
     """Roll out ``checkpoint`` (a file, or a training run's directory: its latest) for ``episodes``
     episodes of the environment of ``env_config`` (default: the configuration of the dataset it was
     trained on), seeded ``seed``; ``threads`` caps torch's CPU threads for the duration.
@@ -190,11 +228,18 @@ def evaluate(checkpoint: str | Path, episodes: int, *, seed: int = 0, max_steps:
     ``threads`` torch threads, default 1) give the same episodes as one. More than one worker needs
     an environment that can start episode ``k`` directly (``episode_option``, as ``GoalEnv``) and a
     picklable ``make_env``. ``scenes`` (scene seeds, e.g. :func:`training_scenes`) replaces the
-    environment's own evaluation scenes: episode ``k`` builds ``scenes[k % len(scenes)]``."""
+    environment's own evaluation scenes: episode ``k`` builds ``scenes[k % len(scenes)]``.
+
+    ``batch`` > 1 steps the episodes in consecutive blocks of that many together and samples their
+    chunks as one batch (:func:`rollout_block`): several times cheaper per episode for a diffusion
+    policy on a CPU. Results then depend on ``batch`` (not on ``workers``, which share whole blocks):
+    a batch's arithmetic can differ from one-at-a-time passes in the last bits."""
     if episodes < 1:
         raise PolicyError(f"--episodes must be at least 1, got {episodes}")
     if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
         raise PolicyError(f"--workers must be a positive integer, got {workers!r}")
+    if isinstance(batch, bool) or not isinstance(batch, int) or batch < 1:
+        raise PolicyError(f"--batch must be a positive integer, got {batch!r}")
     torch_device(device)
     payload = load_checkpoint(checkpoint)
     config = env_config if env_config is not None else payload["dataset"].get("config")
@@ -217,12 +262,29 @@ def evaluate(checkpoint: str | Path, episodes: int, *, seed: int = 0, max_steps:
         if workers > 1 and not direct:
             raise PolicyError("this environment cannot start an episode by its index, so its episodes "
                               "cannot be shared among workers; evaluate with --workers 1")
+        if batch > 1 and not direct:
+            raise PolicyError("this environment cannot start an episode by its index, so its episodes "
+                              "cannot be stepped in batches; evaluate with --batch 1")
         began = time.perf_counter()
-        if workers > 1 and episodes > 1:
+        groups = blocks(episodes, batch)
+        if workers > 1 and len(groups) > 1:
             env.close()
-            results = _parallel(str(payload["path"]), episodes, min(workers, episodes), factory, config,
+            results = _parallel(str(payload["path"]), groups, min(workers, len(groups)), factory, config,
                                 seed=seed, max_steps=max_steps, device=device, threads=threads or 1,
                                 progress=progress)
+        elif batch > 1:
+            runners = [PolicyRunner(payload, device=device, seed=seed) for _ in range(min(batch, episodes))]
+            envs = [env] + [factory(config, seed=seed, max_steps=max_steps) for _ in runners[1:]]
+            results = []
+            try:
+                for group in groups:
+                    results += rollout_block(runners[:len(group)], envs[:len(group)], seed, group)
+                    if progress is not None:
+                        for result in results[-len(group):]:
+                            progress(len(results), episodes, result)
+            finally:
+                for extra in envs[1:]:
+                    extra.close()
         else:
             runner = PolicyRunner(payload, device=device, seed=seed)
             results = []
@@ -247,32 +309,40 @@ _WORKER: dict[str, Any] = {}
 def _start_worker(path: str, factory: EnvFactory, config: dict[str, Any], seed: int,
                   max_steps: int | None, device: str, threads: int) -> None:
     torch.set_num_threads(threads)
-    _WORKER["runner"] = PolicyRunner(load_checkpoint(path), device=device, seed=seed)
-    _WORKER["env"] = factory(config, seed=seed, max_steps=max_steps)
-    _WORKER["seed"] = seed
+    _WORKER.update(payload=load_checkpoint(path), factory=factory, config=config, seed=seed,
+                   max_steps=max_steps, device=device, runners=[], envs=[])
 
 
-def _worker_episode(episode: int) -> tuple[int, EpisodeResult]:
-    return episode, rollout(_WORKER["runner"], _WORKER["env"], _WORKER["seed"], episode=episode)
+def _worker_block(group: list[int]) -> list[tuple[int, EpisodeResult]]:
+    """The episodes of one block in this worker (its runners and environments are made once)."""
+    w = _WORKER
+    while len(w["runners"]) < len(group):
+        w["runners"].append(PolicyRunner(w["payload"], device=w["device"], seed=w["seed"]))
+        w["envs"].append(w["factory"](w["config"], seed=w["seed"], max_steps=w["max_steps"]))
+    if len(group) == 1:
+        return [(group[0], rollout(w["runners"][0], w["envs"][0], w["seed"], episode=group[0]))]
+    done = rollout_block(w["runners"][:len(group)], w["envs"][:len(group)], w["seed"], group)
+    return list(zip(group, done, strict=True))
 
 
-def _parallel(path: str, episodes: int, workers: int, factory: EnvFactory, config: dict[str, Any], *,
-              seed: int, max_steps: int | None, device: str, threads: int,
+def _parallel(path: str, groups: list[list[int]], workers: int, factory: EnvFactory, config: dict[str, Any],
+              *, seed: int, max_steps: int | None, device: str, threads: int,
               progress: Callable[[int, int, EpisodeResult], None] | None) -> list[EpisodeResult]:
-    """Episodes 0..episodes-1 over ``workers`` spawned processes, returned in episode order."""
+    """The blocks of episodes ``groups`` over ``workers`` spawned processes, in episode order."""
     import multiprocessing
     from concurrent.futures import ProcessPoolExecutor, as_completed
 
+    episodes = sum(len(g) for g in groups)
     results: dict[int, EpisodeResult] = {}
     context = multiprocessing.get_context("spawn")  # no forked MuJoCo, GL or torch state
     with ProcessPoolExecutor(workers, mp_context=context, initializer=_start_worker,
                              initargs=(path, factory, config, seed, max_steps, device, threads)) as pool:
-        futures = [pool.submit(_worker_episode, k) for k in range(episodes)]
+        futures = [pool.submit(_worker_block, group) for group in groups]
         for future in as_completed(futures):
-            k, result = future.result()
-            results[k] = result
-            if progress is not None:
-                progress(len(results), episodes, result)
+            for k, result in future.result():
+                results[k] = result
+                if progress is not None:
+                    progress(len(results), episodes, result)
     return [results[k] for k in range(episodes)]
 
 

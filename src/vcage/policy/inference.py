@@ -9,7 +9,7 @@ current frame (index ``n_obs_steps - 1`` of the chunk), as Diffusion Policy exec
 from __future__ import annotations
 
 from collections import deque
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 import numpy as np
@@ -19,7 +19,7 @@ from vcage.policy.config import TrainConfig
 from vcage.policy.dataset import FeatureSpec
 from vcage.policy.encoding import ObservationEncoder
 from vcage.policy.errors import PolicyError
-from vcage.policy.models import Policy, make_policy
+from vcage.policy.models import Policy, make_policy, randn
 from vcage.policy.normalize import Normalizer
 
 
@@ -66,14 +66,37 @@ class PolicyRunner:
 
     def act(self, obs: Mapping[str, Any]) -> np.ndarray:
         """The action for this step of the episode, given the environment's observation."""
+        return act_together([self], [obs])[0]
+
+    def _observe(self, obs: Mapping[str, Any]) -> None:
         vector = self.obs_norm.normalize(self.observation_vector(obs))
         if not self._window:
             self._window.extend([vector] * self.config.n_obs_steps)
         else:
             self._window.append(vector)
-        if not self._queue:
-            window = torch.from_numpy(np.stack(self._window)[None]).to(self.device)
-            chunk = self.model.predict(window, self.generator)[0].cpu().numpy()
-            start = self.config.n_obs_steps - 1
-            self._queue.extend(self.action_norm.unnormalize(chunk[start:start + self.config.n_action_steps]))
-        return self._queue.popleft()
+
+    def _queue_chunk(self, chunk: np.ndarray) -> None:
+        start = self.config.n_obs_steps - 1
+        self._queue.extend(self.action_norm.unnormalize(chunk[start:start + self.config.n_action_steps]))
+
+
+def act_together(runners: Sequence[PolicyRunner],
+                 observations: Sequence[Mapping[str, Any]]) -> list[np.ndarray]:
+    """One action for each of ``runners`` (episodes of the same checkpoint) given its observation.
+
+    The runners whose queue is empty sample their chunks as one batch through the first runner's
+    network, each starting from noise drawn from its own generator, so an episode's noise does not
+    depend on the others. One runner alone is :meth:`PolicyRunner.act`; a batch's outputs can
+    differ from one-at-a-time passes in the last bits of the floating-point arithmetic."""
+    for runner, obs in zip(runners, observations, strict=True):
+        runner._observe(obs)
+    due = [r for r in runners if not r._queue]
+    if due:
+        lead = runners[0]
+        windows = torch.from_numpy(np.stack([np.stack(r._window) for r in due])).to(lead.device)
+        shape = (1, lead.config.horizon, lead.action_feature.size)
+        noise = torch.cat([randn(shape, r.generator, windows) for r in due])
+        chunks = lead.model.predict_from(windows, noise).cpu().numpy()
+        for runner, chunk in zip(due, chunks, strict=True):
+            runner._queue_chunk(chunk)
+    return [r._queue.popleft() for r in runners]

@@ -32,6 +32,11 @@ class Policy(nn.Module):
     def predict(self, obs: torch.Tensor, generator: torch.Generator) -> torch.Tensor:
         raise NotImplementedError
 
+    def predict_from(self, obs: torch.Tensor, noise: torch.Tensor) -> torch.Tensor:
+        """The chunk for ``obs`` starting from the given initial noise (B, horizon, action_dim), so
+        that each sample of a batch can draw its noise from its own generator."""
+        raise NotImplementedError
+
 
 POLICIES: Registry[type[Policy]] = Registry("policy", error=ConfigError)
 
@@ -66,9 +71,13 @@ class DiffusionPolicy(Policy):
 
     @torch.no_grad()
     def predict(self, obs: torch.Tensor, generator: torch.Generator) -> torch.Tensor:
+        return self.predict_from(obs, randn((obs.shape[0], self.config.horizon, self.action_dim), generator,
+                                            obs))
+
+    @torch.no_grad()
+    def predict_from(self, obs: torch.Tensor, noise: torch.Tensor) -> torch.Tensor:
         cond = obs.flatten(1)
-        x = randn((obs.shape[0], self.config.horizon, self.action_dim), generator, obs)
-        return self.schedule.sample(lambda x_t, t: self.unet(x_t, t, cond), x)
+        return self.schedule.sample(lambda x_t, t: self.unet(x_t, t, cond), noise)
 
 
 @POLICIES.register("mlp")
@@ -92,4 +101,8 @@ class MlpPolicy(Policy):
 
     @torch.no_grad()
     def predict(self, obs: torch.Tensor, generator: torch.Generator) -> torch.Tensor:
+        return self(obs)
+
+    @torch.no_grad()
+    def predict_from(self, obs: torch.Tensor, noise: torch.Tensor) -> torch.Tensor:
         return self(obs)
