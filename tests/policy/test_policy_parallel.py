@@ -64,8 +64,8 @@ def test_two_workers_give_the_episodes_of_one(generated: Path, diffusion_run: Pa
     assert [e.scene_seed for e in one.episodes] == [eval_seed(7, k, 0) for k in range(3)]
 
 
-def test_workers_need_an_environment_that_starts_episodes_by_index(diffusion_run: Path,
-                                                                   generated: Path) -> None:
+def test_workers_and_batches_need_an_environment_that_starts_episodes_by_index(diffusion_run: Path,
+                                                                               generated: Path) -> None:
     config = DatasetReader(generated).config
 
     def opaque(cfg: dict[str, Any], *, seed: int, max_steps: int | None = None) -> gym.Env:
@@ -75,6 +75,10 @@ def test_workers_need_an_environment_that_starts_episodes_by_index(diffusion_run
         evaluate(diffusion_run, 2, env_config=config, make_env=opaque, workers=2, max_steps=4)
     with pytest.raises(PolicyError, match="--workers"):
         evaluate(diffusion_run, 2, workers=0)
+    with pytest.raises(PolicyError, match="--batch 1"):
+        evaluate(diffusion_run, 2, env_config=config, make_env=opaque, batch=2, max_steps=4)
+    with pytest.raises(PolicyError, match="--batch must be a positive integer"):
+        evaluate(diffusion_run, 2, batch=0)
     env = make_env(config, seed=1, max_steps=4)
     with pytest.raises(ConfigError, match="episode index"):
         env.reset(options={"episode": -1})
@@ -119,15 +123,3 @@ def test_a_block_samples_each_episodes_chunk_from_its_own_noise(generated: Path,
     for env in (solo, *pair):
         env.close()
 
-
-def test_batches_need_an_environment_that_starts_episodes_by_index(diffusion_run: Path,
-                                                                   generated: Path) -> None:
-    config = DatasetReader(generated).config
-
-    def opaque(cfg: dict[str, Any], *, seed: int, max_steps: int | None = None) -> gym.Env:
-        return _NoIndex(make_env(cfg, seed=seed, max_steps=max_steps))
-
-    with pytest.raises(PolicyError, match="--batch 1"):
-        evaluate(diffusion_run, 2, env_config=config, make_env=opaque, batch=2, max_steps=4)
-    with pytest.raises(PolicyError, match="--batch must be a positive integer"):
-        evaluate(diffusion_run, 2, batch=0)
