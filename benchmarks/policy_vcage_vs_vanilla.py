@@ -79,7 +79,7 @@ def make_datasets(task: str, work: Path, demos: int, seed: int, size: int,
 
     out = {}
     for method in METHODS:
-        root = work / "data" / slug(task) / method
+        root = dataset_dir(work, task, method)
         funnel = generate(task, demos, root, generation_config(method, seed, size, workers), total=True)
         print(f"  {method:8s} {funnel.dataset_episodes} demos ({funnel.attempts} attempts this run)",
               flush=True)
@@ -116,6 +116,10 @@ def result_path(work: Path, task: str, method: str, train_seed: int) -> Path:
     return work / "results" / slug(task) / method / f"seed{train_seed}.json"
 
 
+def dataset_dir(work: Path, task: str, method: str) -> Path:
+    return work / "data" / slug(task) / method
+
+
 def run_dir(work: Path, task: str, method: str, train_seed: int) -> Path:
     return work / "runs" / slug(task) / method / f"seed{train_seed}"
 
@@ -124,10 +128,10 @@ TRAINED = "train.json"  # in a run directory: the finished run's timings, writte
 PROBE_STEPS = 300
 
 
-def train_config(args: argparse.Namespace, train_seed: int, steps: int | None = None) -> Any:
+def train_config(args: argparse.Namespace, train_seed: int) -> Any:
     from vcage.policy import DiffusionConfig, TrainConfig
 
-    steps = args.steps if steps is None else steps
+    steps = args.steps
     diffusion = DiffusionConfig() if args.down_dims is None else \
         DiffusionConfig(down_dims=tuple(args.down_dims))
     return TrainConfig(policy=args.policy, steps=steps, lr=args.lr, seed=train_seed,
@@ -439,17 +443,14 @@ def train_stage(tasks: list[str], args: argparse.Namespace) -> None:
     """Every pending training run of ``tasks``, on ``--device``; reads the datasets only (no simulator)."""
     runs = [(t, m, s) for t in tasks for m in METHODS for s in range(args.train_seeds)]
     pending = [(t, m, s) for t, m, s in runs if not (run_dir(args.work, t, m, s) / TRAINED).is_file()]
-    datasets = {(t, m): args.work / "data" / slug(t) / m for t in tasks for m in METHODS}
+    datasets = {(t, m): dataset_dir(args.work, t, m) for t in tasks for m in METHODS}
     for path in datasets.values():
         if not (path / "meta" / "info.json").is_file():
             raise SystemExit(f"no dataset at {path}: run --stage data first")
-    steps = args.steps
-    if pending and args.budget is not None:
+    if pending and args.budget is not None:  # the steps that fit the budget, the same for every run
         probes = [(datasets[t, m], run_dir(args.work, t, m, s), train_config(args, s)) for t, m, s in pending]
-        steps = budget_steps(probes, args.budget, args.work, args.workers, args.threads, args.device)
-        args.steps = steps
-    jobs = [(datasets[t, m], run_dir(args.work, t, m, s), train_config(args, s, steps))
-            for t, m, s in pending]
+        args.steps = budget_steps(probes, args.budget, args.work, args.workers, args.threads, args.device)
+    jobs = [(datasets[t, m], run_dir(args.work, t, m, s), train_config(args, s)) for t, m, s in pending]
     trained = train_all(jobs, args.workers, args.threads, args.device)
     for (t, m, s), (_, run, config) in zip(pending, jobs, strict=True):
         seconds, rate, loss = trained[run]
