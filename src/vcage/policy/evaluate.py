@@ -273,18 +273,17 @@ def evaluate(checkpoint: str | Path, episodes: int, *, seed: int = 0, max_steps:
                                 seed=seed, max_steps=max_steps, device=device, threads=threads or 1,
                                 progress=progress)
         elif batch > 1:
-            runners = [PolicyRunner(payload, device=device, seed=seed) for _ in range(min(batch, episodes))]
-            envs = [env] + [factory(config, seed=seed, max_steps=max_steps) for _ in runners[1:]]
+            blocks_here = Blocks(payload, factory, config, seed=seed, max_steps=max_steps, device=device,
+                                 envs=[env])
             results = []
             try:
                 for group in groups:
-                    results += rollout_block(runners[:len(group)], envs[:len(group)], seed, group)
+                    results += blocks_here.run(group)
                     if progress is not None:
                         for result in results[-len(group):]:
                             progress(len(results), episodes, result)
             finally:
-                for extra in envs[1:]:
-                    extra.close()
+                blocks_here.close(keep=1)  # the first environment is ``env``, closed below
         else:
             runner = PolicyRunner(payload, device=device, seed=seed)
             results = []
@@ -306,23 +305,42 @@ def evaluate(checkpoint: str | Path, episodes: int, *, seed: int = 0, max_steps:
 _WORKER: dict[str, Any] = {}
 
 
+class Blocks:
+    """Runs blocks of episodes; a runner and an environment per episode of the largest block so
+    far, made when a block first needs them and kept for the next ones."""
+
+    def __init__(self, payload: Mapping[str, Any], factory: EnvFactory, config: dict[str, Any], *, seed: int,
+                 max_steps: int | None, device: str, envs: Sequence[gym.Env] = ()) -> None:
+        self.payload, self.factory, self.config = payload, factory, config
+        self.seed, self.max_steps, self.device = seed, max_steps, device
+        self.envs: list[gym.Env] = list(envs)
+        self.runners: list[PolicyRunner] = []
+
+    def run(self, group: Sequence[int]) -> list[EpisodeResult]:
+        while len(self.runners) < len(group):
+            self.runners.append(PolicyRunner(self.payload, device=self.device, seed=self.seed))
+        while len(self.envs) < len(group):
+            self.envs.append(self.factory(self.config, seed=self.seed, max_steps=self.max_steps))
+        if len(group) == 1:
+            return [rollout(self.runners[0], self.envs[0], self.seed, episode=group[0])]
+        return rollout_block(self.runners[:len(group)], self.envs[:len(group)], self.seed, group)
+
+    def close(self, keep: int = 0) -> None:
+        """Close the environments this made (all but the first ``keep``, which the caller owns)."""
+        for env in self.envs[keep:]:
+            env.close()
+
+
 def _start_worker(path: str, factory: EnvFactory, config: dict[str, Any], seed: int,
                   max_steps: int | None, device: str, threads: int) -> None:
     torch.set_num_threads(threads)
-    _WORKER.update(payload=load_checkpoint(path), factory=factory, config=config, seed=seed,
-                   max_steps=max_steps, device=device, runners=[], envs=[])
+    _WORKER["blocks"] = Blocks(load_checkpoint(path), factory, config, seed=seed, max_steps=max_steps,
+                               device=device)
 
 
 def _worker_block(group: list[int]) -> list[tuple[int, EpisodeResult]]:
-    """The episodes of one block in this worker (its runners and environments are made once)."""
-    w = _WORKER
-    while len(w["runners"]) < len(group):
-        w["runners"].append(PolicyRunner(w["payload"], device=w["device"], seed=w["seed"]))
-        w["envs"].append(w["factory"](w["config"], seed=w["seed"], max_steps=w["max_steps"]))
-    if len(group) == 1:
-        return [(group[0], rollout(w["runners"][0], w["envs"][0], w["seed"], episode=group[0]))]
-    done = rollout_block(w["runners"][:len(group)], w["envs"][:len(group)], w["seed"], group)
-    return list(zip(group, done, strict=True))
+    """The episodes of one block in this worker."""
+    return list(zip(group, _WORKER["blocks"].run(group), strict=True))
 
 
 def _parallel(path: str, groups: list[list[int]], workers: int, factory: EnvFactory, config: dict[str, Any],
