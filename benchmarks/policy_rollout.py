@@ -39,7 +39,8 @@ def main() -> None:
 
     torch.set_num_threads(1)
     checkpoint = load_checkpoint(args.checkpoint)
-    env = make_env(checkpoint["dataset"]["config"], max_steps=args.max_steps)
+    env = make_env(checkpoint["dataset"]["config"], max_steps=args.max_steps,
+                   action=checkpoint["action_feature"]["name"])
     runner = PolicyRunner(checkpoint)
     policy = stepping = resetting = 0.0
     steps = 0

@@ -135,7 +135,7 @@ def train_config(args: argparse.Namespace, train_seed: int) -> Any:
     diffusion = DiffusionConfig() if args.down_dims is None else \
         DiffusionConfig(down_dims=tuple(args.down_dims))
     return TrainConfig(policy=args.policy, steps=steps, lr=args.lr, seed=train_seed,
-                       batch_size=args.batch_size, diffusion=diffusion,
+                       batch_size=args.batch_size, diffusion=diffusion, action_key=args.action,
                        checkpoint_every=max(1, min(args.checkpoint_every, steps)))
 
 
@@ -371,6 +371,8 @@ def main() -> None:
     parser.add_argument("--eval", type=int, default=50, help="held-out scenes per task")
     parser.add_argument("--train-seeds", type=int, default=3)
     parser.add_argument("--policy", choices=("diffusion", "mlp"), default="diffusion")
+    parser.add_argument("--action", choices=("action", "action.ee_pose"), default="action",
+                        help="what the policies predict: joint targets, or the tool's pose (IK in the env)")
     parser.add_argument("--steps", type=int, default=15000, help="training steps per checkpoint run")
     parser.add_argument("--lr", type=float, default=1e-3, help="peak learning rate")
     parser.add_argument("--batch-size", type=int, default=64)

@@ -32,6 +32,25 @@ def test_ik_failures_are_typed() -> None:
         ik.solve(np.array([-0.05, 0.0, 0.45]), down_rotation(0.0), HOME_QPOS)
 
 
+def test_ik_tracking_follows_a_pose_from_the_last_joints_and_never_raises(world: World) -> None:
+    ik = IKSolver((0.0, 0.0, 0.75))
+    start = ik.solve(np.array([0.5, 0.1, 0.85]), down_rotation(0.3), HOME_QPOS)
+    target = np.array([0.52, 0.08, 0.83])  # 3 cm away: one control step of a fast motion
+    q = ik.track(target, down_rotation(0.35), start)
+    world.data.qpos[world.robot.arm_qpos] = q
+    import mujoco
+
+    mujoco.mj_forward(world.model, world.data)
+    pos, rot = world.robot.tcp_pose(world.data)
+    np.testing.assert_allclose(pos, target, atol=0.0006)  # a quarter of solve's 2 mm
+    np.testing.assert_allclose(rot, down_rotation(0.35), atol=0.01)
+    assert np.abs(q - start).max() < 0.3  # near the joints it started from
+    far = ik.track(np.array([1.5, 0.0, 0.8]), down_rotation(0.0), start)  # out of reach: the nearest
+    low, high = world.robot.arm_limits[:, 0], world.robot.arm_limits[:, 1]
+    assert np.isfinite(far).all() and (far >= low - 1e-6).all() and (far <= high + 1e-6).all()
+    np.testing.assert_allclose(ik.solve(np.array([0.5, 0.1, 0.85]), down_rotation(0.3), HOME_QPOS), start)
+
+
 def test_pick_and_place_stacks_and_records(world: World) -> None:
     skills = Skills(world)
     plan = SKILLS.get("pick_and_place")(skills, obj="a", target="b")

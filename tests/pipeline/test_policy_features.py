@@ -22,7 +22,7 @@ from vcage.errors import ConfigError, DatasetError
 from vcage.pipeline.backfill import backfill
 from vcage.pipeline.config import SEED_LIMIT, GenerateConfig
 from vcage.pipeline.evaluation import make_env
-from vcage.pipeline.features import ENVIRONMENT, SUBTASK
+from vcage.pipeline.features import ACTION, ACTION_EE, ENVIRONMENT, SUBTASK
 from vcage.pipeline.generate import generate
 from vcage.scene.instantiate import SceneConfig
 
@@ -46,7 +46,7 @@ def ds(made: Path, tmp_path: Path) -> Path:
     return tmp_path / "ds"
 
 
-def strip(root: Path, keys: tuple[str, ...] = (ENVIRONMENT, SUBTASK)) -> None:
+def strip(root: Path, keys: tuple[str, ...] = (ENVIRONMENT, SUBTASK, ACTION_EE)) -> None:
     """Make ``root`` what an older version wrote: without the features ``keys``."""
     for path in (root / "data").rglob("*.parquet"):
         table = pq.read_table(path)
@@ -130,6 +130,39 @@ def test_evaluation_scenes_are_never_training_scenes_and_repeat_by_seed(made: Pa
     assert env.observation_space.contains(obs)
 
 
+def test_replaying_the_tool_poses_through_ik_completes_the_episode_on_the_demonstrated_path(
+        made: Path) -> None:
+    reader = DatasetReader(made)
+    ep = reader.episode(0)
+    tool, pose = ep.frames[ACTION_EE], ep.frames["observation.ee_pose"]
+    assert tuple(reader.features[ACTION_EE].names or ()) == ("x", "y", "z", "qw", "qx", "qy", "qz", "gripper")
+    np.testing.assert_array_equal(tool[:, 7], ep.frames[ACTION][:, 7])
+    held = np.r_[False, np.linalg.norm(np.diff(ep.frames[ACTION][:, :7], axis=0), axis=1) == 0]
+    run = np.zeros(len(held), dtype=int)  # for how many frames the arm has held its target
+    for t in range(1, len(held)):
+        run[t] = run[t - 1] + 1 if held[t] else 0
+    still = int(np.argmax(run))  # the end of the longest hold: the hand has reached the target
+    assert run[still] >= 5
+    assert np.linalg.norm(tool[still, :3] - pose[still, :3]) < 0.003  # it is where the action's pose says
+    env = make_env(reader.config, seed=0, action=ACTION_EE)
+    assert env.action_space.shape == (8,)
+    assert tuple(env.features[ACTION_EE].names) == tuple(reader.features[ACTION_EE].names or ())
+    obs, info = env.reset(options={"scene_seed": ep.extras["seed"]})
+    gap = []
+    for t in range(ep.length):
+        gap.append(np.linalg.norm(obs["observation.ee_pose"][:3] - pose[t, :3]))
+        obs, reward, terminated, truncated, info = env.step(tool[t])
+        if terminated:
+            break
+    assert info["success"] and reward == 1.0
+    assert np.median(gap) < 0.002 and max(gap) < 0.05  # the hand follows the demonstration's path
+    env.reset()
+    with pytest.raises(ValueError, match="quaternion"):
+        env.step(np.r_[0.5, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0])
+    with pytest.raises(ConfigError, match="unknown action 'torque'"):
+        make_env(reader.config, action="torque")
+
+
 def test_the_evaluation_env_refuses_bad_input(made: Path) -> None:
     env = make_env(DatasetReader(made).config, seed=0, max_steps=10)
     with pytest.raises(ResetNeeded):
@@ -148,9 +181,9 @@ def test_the_evaluation_env_refuses_bad_input(made: Path) -> None:
 def test_backfill_gives_an_older_dataset_the_features_generation_writes(ds: Path, made: Path) -> None:
     strip(ds)
     assert ENVIRONMENT not in DatasetReader(ds).features
-    assert backfill(ds) == [ENVIRONMENT, SUBTASK]
+    assert backfill(ds) == [ENVIRONMENT, SUBTASK, ACTION_EE]
     for new, original in zip(frames(ds), frames(made), strict=True):
-        for key in (ENVIRONMENT, SUBTASK):
+        for key in (ENVIRONMENT, SUBTASK, ACTION_EE):
             np.testing.assert_array_equal(new[key], original[key])
     assert DatasetReader(ds).features == DatasetReader(made).features
     assert json.loads((ds / STATS_PATH).read_text())[ENVIRONMENT] == json.loads(
@@ -174,7 +207,7 @@ def test_an_interrupted_backfill_leaves_the_dataset_as_it_was_and_completes_on_r
         backfill(ds)
     assert DatasetReader(ds).features == before and verify(ds).ok
     monkeypatch.undo()
-    assert backfill(ds) == [ENVIRONMENT, SUBTASK] and verify(ds).ok
+    assert backfill(ds) == [ENVIRONMENT, SUBTASK, ACTION_EE] and verify(ds).ok
     assert [f[SUBTASK].max() for f in frames(ds)] == [1, 1]
 
 

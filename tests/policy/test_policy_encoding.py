@@ -13,7 +13,7 @@ from vcage.errors import ConfigError
 from vcage.policy.checkpoint import load_checkpoint
 from vcage.policy.config import TrainConfig
 from vcage.policy.dataset import FeatureSpec, load_training_data
-from vcage.policy.encoding import ObservationEncoder, quaternion_starts, rot6d
+from vcage.policy.encoding import VectorEncoder, quaternion_starts, rot6d
 from vcage.policy.inference import PolicyRunner
 from vcage.policy.train import train
 
@@ -47,7 +47,7 @@ def test_rot6d_is_the_rotation_matrix_first_two_columns_and_blind_to_the_sign() 
 def test_a_gripper_pointing_down_reads_the_same_across_the_stored_sign_flip() -> None:
     """The end effector's stored quaternion jumps from (0, 1, 0, 0) to (0, -1, 0, 0) when w crosses
     zero; the encoded input moves by the small rotation between the two frames only."""
-    encoder = ObservationEncoder(FEATURES[1:2], "rot6d")
+    encoder = VectorEncoder(FEATURES[1:2], "rot6d")
     before = np.array([0.4, 0.0, 1.1, 0.001, 1.0, 0.0, 0.01], dtype=np.float32)
     # a frame later w is -0.001: stored with w >= 0, i.e. negated
     after = np.array([0.4, 0.0, 1.1, 0.001, -1.0, 0.0, -0.01], dtype=np.float32)
@@ -59,7 +59,7 @@ def test_a_gripper_pointing_down_reads_the_same_across_the_stored_sign_flip() ->
 
 
 def test_the_encoder_keeps_every_other_value_in_place_and_grows_by_two_per_quaternion() -> None:
-    encoder = ObservationEncoder(FEATURES, "rot6d")
+    encoder = VectorEncoder(FEATURES, "rot6d")
     raw = np.arange(23, dtype=np.float32) / 23 + 0.1
     out = encoder(np.stack([raw, raw]))
     assert encoder.raw_size == 23 and encoder.size == 29 and out.shape == (2, 29) and out.dtype == np.float32
@@ -67,12 +67,12 @@ def test_the_encoder_keeps_every_other_value_in_place_and_grows_by_two_per_quate
     np.testing.assert_allclose(out[0, 5:11], rot6d(raw[5:9]), rtol=1e-6)
     np.testing.assert_array_equal(out[0, 11:14], raw[9:12])  # the bell's position
     np.testing.assert_array_equal(out[0, 20:23], raw[16:19])  # the pad's position
-    passthrough = ObservationEncoder(FEATURES, "quaternion")
+    passthrough = VectorEncoder(FEATURES, "quaternion")
     assert passthrough.size == 23 and np.array_equal(passthrough(raw), raw)
     with pytest.raises(ValueError, match="expected 23"):
         encoder(raw[:-1])
     with pytest.raises(ConfigError, match="rot6d"):
-        ObservationEncoder(FEATURES, "euler")
+        VectorEncoder(FEATURES, "euler")
 
 
 def test_the_default_is_rot6d_and_checkpoints_written_before_the_choice_read_quaternions(
@@ -97,5 +97,5 @@ def test_training_data_carries_the_encoded_observations(dataset: Path) -> None:
     encoded = load_training_data(dataset, tiny("mlp"))
     raw = load_training_data(dataset, tiny("mlp", rotations="quaternion"))
     assert raw.obs.shape[1] == 22 and encoded.obs.shape[1] == 26  # two quaternions, 4 -> 6 values each
-    encoder = ObservationEncoder(raw.obs_features, "rot6d")
+    encoder = VectorEncoder(raw.obs_features, "rot6d")
     np.testing.assert_allclose(encoded.obs, encoder(raw.obs), rtol=1e-6)

@@ -68,7 +68,8 @@ def test_workers_and_batches_need_an_environment_that_starts_episodes_by_index(d
                                                                                generated: Path) -> None:
     config = DatasetReader(generated).config
 
-    def opaque(cfg: dict[str, Any], *, seed: int, max_steps: int | None = None) -> gym.Env:
+    def opaque(cfg: dict[str, Any], *, seed: int, max_steps: int | None = None,
+               action: str = "action") -> gym.Env:
         return _NoIndex(make_env(cfg, seed=seed, max_steps=max_steps))
 
     with pytest.raises(PolicyError, match="--workers 1"):

@@ -92,7 +92,8 @@ def test_the_runner_predicts_every_eight_steps_from_a_two_frame_window(checkpoin
 def test_evaluate_rolls_out_every_episode_and_counts_what_the_environment_reports(checkpoint: Path) -> None:
     envs: list[CountingEnv] = []
 
-    def make_env(config: dict[str, Any], *, seed: int, max_steps: int | None = None) -> gym.Env:
+    def make_env(config: dict[str, Any], *, seed: int, max_steps: int | None = None,
+                 action: str = "action") -> gym.Env:
         envs.append(CountingEnv({0, 2}, max_steps=max_steps or 12))
         return envs[-1]
 

@@ -14,7 +14,7 @@ from vcage.cli.errors import cli_errors
 @app.command("backfill")
 @cli_errors
 def backfill_cmd(path: Path = typer.Argument(..., help="a dataset made by `vcage generate`")) -> None:
-    """Add observation.environment_state and subtask_index from the stored simulator states."""
+    """Add observation.environment_state, subtask_index and action.ee_pose from the stored states."""
     from vcage.pipeline.backfill import BACKFILLED, backfill
 
     added = backfill(path, progress=lambda done, total: console.print(

@@ -27,6 +27,9 @@ def train_cmd(
         obs: str = typer.Option(None, help="comma-separated observation features (default: "
                                 "observation.state, observation.ee_pose and observation.environment_state "
                                 "if the dataset has it)"),
+        action: str = typer.Option(None, help="what the policy predicts: action (default: the 7 joint "
+                                   "targets and the gripper) or action.ee_pose (the tool's target pose "
+                                   "and the gripper; evaluation turns it into joint targets by IK)"),
         rotations: str = typer.Option(None, help="how the policy reads quaternions: rot6d (default: "
                                       "rotation-matrix columns, continuous) or quaternion (as stored)"),
         keep_checkpoints: int = typer.Option(None, min=1, help="keep only this many newest checkpoints "
@@ -47,6 +50,7 @@ def train_cmd(
 
     given: dict[str, Any] = {"policy": policy, "steps": steps, "batch_size": batch_size, "lr": lr,
                              "seed": seed, "checkpoint_every": checkpoint_every, "rotations": rotations,
+                             "action_key": action,
                              "observation_keys": tuple(k.strip() for k in obs.split(",") if k.strip())
                              if obs else None}
     given = {k: v for k, v in given.items() if v is not None}

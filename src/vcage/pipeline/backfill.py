@@ -3,8 +3,9 @@ states it stores, without generating anything again.
 
 ``observation.environment_state`` is the kinematics of each stored state (the episode's world is
 composed again from the scene spec in its extras); ``subtask_index`` comes from the subtask frame
-ranges in its extras. The columns are added by :func:`vcage.data.columns.add_features`
-(crash-safe: ``meta/info.json`` commits them last; running it again completes an interrupted run).
+ranges in its extras; ``action.ee_pose`` is the forward kinematics of each frame's joint action. The
+columns are added by :func:`vcage.data.columns.add_features` (crash-safe: ``meta/info.json`` commits
+them last; running it again completes an interrupted run).
 """
 
 from __future__ import annotations
@@ -19,9 +20,12 @@ from vcage.data.columns import add_features
 from vcage.errors import DatasetError
 from vcage.pipeline.config import GenerateConfig
 from vcage.pipeline.features import (
+    ACTION,
+    ACTION_EE,
     ENVIRONMENT,
     SUBTASK,
     dataset_features,
+    ee_actions,
     environment_states,
     subtask_indices,
 )
@@ -29,7 +33,7 @@ from vcage.planning.schema import Plan
 from vcage.scene.compose import compose
 from vcage.scene.spec import SceneSpec
 
-BACKFILLED = (ENVIRONMENT, SUBTASK)
+BACKFILLED = (ENVIRONMENT, SUBTASK, ACTION_EE)
 
 
 def backfill(root: str | Path, progress: Callable[[int, int], None] | None = None) -> list[str]:
@@ -62,9 +66,14 @@ def backfill(root: str | Path, progress: Callable[[int, int], None] | None = Non
         if states.ndim != 2 or states.shape[1] != size:
             raise DatasetError(f"episode {index}: its stored states have {states.shape[-1]} values, the "
                                f"composed scene's state has {size}; it was made by another simulator version")
-        out = {ENVIRONMENT: environment_states(world, plan, states),
-               SUBTASK: subtask_indices([s["frames"] for s in subtasks], len(states))}
-        return {k: v for k, v in out.items() if k in wanted}
+        out: dict[str, np.ndarray] = {}
+        if ENVIRONMENT in wanted:
+            out[ENVIRONMENT] = environment_states(world, plan, states)
+        if SUBTASK in wanted:
+            out[SUBTASK] = subtask_indices([s["frames"] for s in subtasks], len(states))
+        if ACTION_EE in wanted:
+            out[ACTION_EE] = ee_actions(world, reader.episode(index).frames[ACTION])
+        return out
 
     add_features(root, wanted, values, progress)
     return list(wanted)

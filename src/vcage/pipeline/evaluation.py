@@ -14,8 +14,12 @@ randomisation) and simulator settings as the generation run that made the datase
 * **Observations** are the dataset's feature vectors (:mod:`vcage.pipeline.features`):
   ``observation.state``, ``observation.ee_pose``, ``observation.environment_state``, read as the
   recording reads them during generation.
-* **Actions** are the dataset's ``action``: 7 absolute arm joint targets and a gripper command in
-  [0, 1], held for one control period (1 / ``control_hz``).
+* **Actions** are one of the dataset's action features (``action``: the default): ``action``, 7
+  absolute arm joint targets and a gripper command in [0, 1], held for one control period
+  (1 / ``control_hz``); or ``action.ee_pose``, the tool-centre point's target pose (position,
+  quaternion w, x, y, z) and the gripper command, which the environment turns into joint targets by
+  differential inverse kinematics warm-started from the previous step's targets (the joints the
+  recorded demonstrations' poses came from are found again to a fraction of a millimetre).
 * **Success** follows the plan: the subtasks are checked in order, each by the oracle as generation
   checks it (every predicate true on ``HOLD_STEPS`` consecutive control steps; events latched while
   the subtask is the current one). ``info``: ``success``, ``subtasks_done``, ``subtasks``,
@@ -34,14 +38,26 @@ from gymnasium import spaces
 from gymnasium.error import ResetNeeded
 
 from vcage.errors import ConfigError, PlacementError, SceneError, SimulationError
+from vcage.geometry import quat_to_mat
 from vcage.pipeline.config import GenerateConfig
-from vcage.pipeline.features import EE_POSE, ENVIRONMENT, STATE, dataset_features, observe
+from vcage.pipeline.features import (
+    ACTION,
+    ACTION_EE,
+    ACTIONS,
+    EE_POSE,
+    ENVIRONMENT,
+    STATE,
+    dataset_features,
+    observe,
+)
 from vcage.pipeline.plan_layout import episode_scene, plan_layout
 from vcage.planning.schema import Plan
 from vcage.scene.instantiate import Instantiator
+from vcage.scene.spec import ROBOT_MOUNT
 from vcage.sim.render import Renderer
 from vcage.sim.robot import GRIPPER_OPEN
 from vcage.sim.world import World
+from vcage.skills.ik import IKSolver
 from vcage.skills.reachability import reach_map
 from vcage.synthesis.errors import SynthesisError
 from vcage.tasks.oracle import Oracle
@@ -58,15 +74,17 @@ def eval_seed(base: int, episode: int, attempt: int) -> int:
 
 
 def make_env(config: dict[str, Any], *, seed: int = 0, max_steps: int | None = None,
-             render_mode: str | None = None, scenes: Sequence[int] | None = None) -> GoalEnv:
+             render_mode: str | None = None, scenes: Sequence[int] | None = None,
+             action: str = ACTION) -> GoalEnv:
     """The evaluation environment of a dataset made with ``config`` (its ``meta/vcage.json``
-    configuration: ``{"generate": ..., "plan": ...}``); ``scenes``: see :class:`GoalEnv`."""
+    configuration: ``{"generate": ..., "plan": ...}``); ``scenes`` and ``action``: see
+    :class:`GoalEnv`."""
     if not isinstance(config, dict) or not isinstance(config.get("generate"), dict) \
             or not isinstance(config.get("plan"), dict):
         raise ConfigError("an evaluation environment needs the configuration a vcage dataset stores "
                           "(meta/vcage.json: 'generate' and 'plan'); this one has neither")
     return GoalEnv(Plan.model_validate(config["plan"]), GenerateConfig.from_dict(config["generate"]),
-                   seed=seed, max_steps=max_steps, render_mode=render_mode, scenes=scenes)
+                   seed=seed, max_steps=max_steps, render_mode=render_mode, scenes=scenes, action=action)
 
 
 class GoalEnv(gym.Env[dict[str, np.ndarray], np.ndarray]):
@@ -76,14 +94,19 @@ class GoalEnv(gym.Env[dict[str, np.ndarray], np.ndarray]):
     episode sequence of seed ``s`` again; ``options={"episode": k}`` goes to episode ``k`` directly
     (so that several processes can share one evaluation's episodes). With ``scenes`` (scene seeds,
     e.g. held-out scenes chosen once for a comparison), episode ``k`` builds
-    ``scenes[k % len(scenes)]`` instead. After a reset, ``world`` is the episode's :class:`World`.
+    ``scenes[k % len(scenes)]`` instead. ``action`` names the action feature ``step`` takes
+    (``action`` or ``action.ee_pose``, see the module's help). After a reset, ``world`` is the
+    episode's :class:`World`.
     """
 
     metadata: ClassVar[dict[str, Any]] = {"render_modes": ["rgb_array"]}  # type: ignore[misc]
     episode_option: ClassVar[bool] = True  # reset(options={"episode": k}) starts episode k
 
     def __init__(self, plan: Plan, cfg: GenerateConfig, *, seed: int = 0, max_steps: int | None = None,
-                 render_mode: str | None = None, scenes: Sequence[int] | None = None) -> None:
+                 render_mode: str | None = None, scenes: Sequence[int] | None = None,
+                 action: str = ACTION) -> None:
+        if action not in ACTIONS:
+            raise ConfigError(f"unknown action {action!r}; valid: {', '.join(ACTIONS)}")
         if render_mode not in (None, "rgb_array"):
             raise ConfigError(f"render_mode {render_mode!r} is not supported; use None or 'rgb_array'")
         if max_steps is not None and (isinstance(max_steps, bool) or not isinstance(max_steps, int)
@@ -92,8 +115,9 @@ class GoalEnv(gym.Env[dict[str, np.ndarray], np.ndarray]):
         self.plan, self.cfg, self.render_mode = plan, cfg, render_mode
         self.max_steps = max_steps or STEPS_PER_SUBTASK * len(plan.subtasks)
         self.metadata = {**self.metadata, "render_fps": cfg.sim.control_hz}  # type: ignore[misc]
+        self.action_key = action
         self.features = {k: f for k, f in dataset_features(plan).items()
-                         if k in (STATE, EE_POSE, ENVIRONMENT)}
+                         if k in (STATE, EE_POSE, ENVIRONMENT, action)}
         self._base, self._episode = int(seed), 0
         self.scenes = [int(x) for x in scenes] if scenes is not None else None
         if self.scenes is not None and (not self.scenes or min(self.scenes) < 0):
@@ -101,10 +125,16 @@ class GoalEnv(gym.Env[dict[str, np.ndarray], np.ndarray]):
         self._instantiator = Instantiator(cfg.scene, cfg.sim, reach_map())
         self._prebuilt: tuple[int, int, World, int] | None = None  # (base, episode, world, scene seed)
         limits = self._arm_limits()
-        self.action_space = spaces.Box(np.append(limits[:, 0], 0.0).astype(np.float32),
-                                       np.append(limits[:, 1], 1.0).astype(np.float32), dtype=np.float32)
         n = len(plan.objects)
         pose = np.r_[np.full(3, POS_LIMIT), np.ones(4)].astype(np.float32)
+        if action == ACTION_EE:
+            self.action_space = spaces.Box(np.append(-pose, 0.0).astype(np.float32),
+                                           np.append(pose, 1.0).astype(np.float32), dtype=np.float32)
+        else:
+            self.action_space = spaces.Box(np.append(limits[:, 0], 0.0).astype(np.float32),
+                                           np.append(limits[:, 1], 1.0).astype(np.float32), dtype=np.float32)
+        self._ik: IKSolver | None = None
+        self._arm_target: np.ndarray | None = None  # the last joint targets (action.ee_pose's IK seed)
         self.observation_space = spaces.Dict({  # type: ignore[assignment]
             STATE: spaces.Box(np.append(limits[:, 0] - 0.1, -0.01).astype(np.float32),
                               np.append(limits[:, 1] + 0.1, 2 * GRIPPER_OPEN + 0.01).astype(np.float32),
@@ -181,6 +211,7 @@ class GoalEnv(gym.Env[dict[str, np.ndarray], np.ndarray]):
         self._close_renderer()
         self.world, self.scene_seed = world, scene_seed
         self._done = self._streak = self._steps = 0
+        self._arm_target = world.robot.arm_q(world.data)
         self._oracle.begin(self.plan.subtasks[0].predicates)
         return observe(world, self.plan), self._info()
 
@@ -190,8 +221,12 @@ class GoalEnv(gym.Env[dict[str, np.ndarray], np.ndarray]):
             raise ResetNeeded("call reset() before step(), and again after an episode ends")
         action = np.asarray(action, dtype=float).reshape(-1)
         if action.shape != (8,) or not np.isfinite(action).all():
-            raise ValueError(f"an action is 8 finite numbers (7 joint targets, gripper), got {action!r}")
-        world.step(world.robot.ctrl(action[:7], float(action[7])))
+            parts = "position, quaternion, gripper" if self.action_key == ACTION_EE \
+                else "7 joint targets, gripper"
+            raise ValueError(f"an action is 8 finite numbers ({parts}), got {action!r}")
+        if self.action_key == ACTION_EE and np.linalg.norm(action[3:7]) < 1e-6:
+            raise ValueError(f"the action's quaternion (elements 3-6) is zero, got {action!r}")
+        world.step(world.robot.ctrl(self._joint_targets(action), float(action[7])))
         self._steps += 1
         self._oracle.on_step(world)
         reward = 0.0
@@ -209,6 +244,16 @@ class GoalEnv(gym.Env[dict[str, np.ndarray], np.ndarray]):
         terminated = self._done == len(self.plan.subtasks)
         truncated = not terminated and self._steps >= self.max_steps
         return observe(world, self.plan), reward, terminated, truncated, self._info()
+
+    def _joint_targets(self, action: np.ndarray) -> np.ndarray:
+        """The arm's joint targets of an action: as given, or from the tool pose by IK."""
+        if self.action_key != ACTION_EE:
+            return action[:7]
+        if self._ik is None:
+            self._ik = IKSolver(ROBOT_MOUNT)
+        assert self._arm_target is not None
+        self._arm_target = self._ik.track(action[:3], quat_to_mat(action[3:7]), self._arm_target)
+        return self._arm_target
 
     def _info(self) -> dict[str, Any]:
         n = len(self.plan.subtasks)

@@ -11,7 +11,12 @@ exactly what it was trained on:
   order the plan lists them (LeRobot's name for low-dimensional environment state), from the
   kinematics of the frame's simulator state; distractors are not included;
 * ``subtask_index`` (1, int64): the subtask of the plan the frame belongs to (0-based);
-* ``action`` (8): the 7 arm joint targets and the gripper command (1 open, 0 closed).
+* ``action`` (8): the 7 arm joint targets and the gripper command (1 open, 0 closed);
+* ``action.ee_pose`` (8): the same action in the tool's space: the tool-centre-point pose the joint
+  targets put the hand at (forward kinematics: position and quaternion ``w >= 0``) and the gripper
+  command. The evaluation environment takes either (:class:`vcage.pipeline.evaluation.GoalEnv`'s
+  ``action``); a policy that predicts poses generalises over object positions more directly than
+  one that predicts joint angles.
 """
 
 from __future__ import annotations
@@ -29,7 +34,8 @@ from vcage.sim.world import World
 JOINTS = [f"joint{i}" for i in range(1, 8)]
 POSE = ("x", "y", "z", "qw", "qx", "qy", "qz")
 STATE, EE_POSE, ENVIRONMENT = "observation.state", "observation.ee_pose", "observation.environment_state"
-SUBTASK, ACTION = "subtask_index", "action"
+SUBTASK, ACTION, ACTION_EE = "subtask_index", "action", "action.ee_pose"
+ACTIONS = (ACTION, ACTION_EE)
 
 
 def objects_of(plan: Plan) -> list[str]:
@@ -46,6 +52,7 @@ def dataset_features(plan: Plan) -> dict[str, Feature]:
                              names=[f"{name}.{c}" for name in objects_of(plan) for c in POSE]),
         SUBTASK: Feature("int64", (1,), names=["subtask"]),
         ACTION: Feature("float32", (8,), names=[*JOINTS, "gripper"]),
+        ACTION_EE: Feature("float32", (8,), names=[*POSE, "gripper"]),
     }
 
 
@@ -53,6 +60,14 @@ def environment_states(world: World, plan: Plan, states: np.ndarray) -> np.ndarr
     """(T, 7 * objects) environment state of each recorded simulator state."""
     names = objects_of(plan)
     return np.stack([world.object_poses(names, state).reshape(-1) for state in states]).astype(np.float32)
+
+
+def ee_actions(world: World, actions: np.ndarray) -> np.ndarray:
+    """(T, 8) ``action.ee_pose`` of (T, 8) joint actions: where each row's joint targets put the
+    tool-centre point, and its gripper command. Computed from the actions as the dataset stores them
+    (float32), so generation and back-fill write the same values."""
+    actions = np.asarray(actions, dtype=np.float32).astype(float).reshape(len(actions), -1)
+    return np.column_stack([world.tcp_poses(actions[:, :7]), actions[:, 7]]).astype(np.float32)
 
 
 def subtask_indices(bounds: Sequence[Sequence[int]], length: int) -> np.ndarray:
@@ -64,16 +79,18 @@ def subtask_indices(bounds: Sequence[Sequence[int]], length: int) -> np.ndarray:
     return out
 
 
-def frames_of(recording: dict[str, np.ndarray], env_state: np.ndarray,
-              subtasks: np.ndarray) -> dict[str, Any]:
+def frames_of(recording: dict[str, np.ndarray], env_state: np.ndarray, subtasks: np.ndarray,
+              ee_action: np.ndarray) -> dict[str, Any]:
     """The dataset frames of an accepted attempt from its recording arrays
-    (:meth:`vcage.skills.playback.Recording.arrays`)."""
+    (:meth:`vcage.skills.playback.Recording.arrays`), with the features computed from its world
+    (:func:`environment_states`, :func:`subtask_indices`, :func:`ee_actions`)."""
     return {
         STATE: np.column_stack([recording["qpos"], recording["gripper"]]).astype(np.float32),
         EE_POSE: np.column_stack([recording["ee_pos"], recording["ee_quat"]]).astype(np.float32),
         ENVIRONMENT: env_state,
         SUBTASK: subtasks,
         ACTION: recording["action"].astype(np.float32),
+        ACTION_EE: ee_action,
     }
 
 

@@ -17,7 +17,7 @@ import numpy as np
 from vcage.critics import Critic, make_critic
 from vcage.pipeline.config import GenerateConfig
 from vcage.pipeline.episode import Attempt, Timing, attempt
-from vcage.pipeline.features import environment_states, frames_of, subtask_indices
+from vcage.pipeline.features import ee_actions, environment_states, frames_of, subtask_indices
 from vcage.planning.schema import Plan
 from vcage.sim.render import Renderer
 
@@ -101,7 +101,7 @@ def episode_data(plan: Plan, cfg: GenerateConfig, result: Attempt,
     states = np.asarray(result.recording.states)
     bounds = [(o.start, o.end) for o in result.rollout.outcomes]
     frames = frames_of(rec, environment_states(result.world, plan, states),
-                       subtask_indices(bounds, len(states)))
+                       subtask_indices(bounds, len(states)), ee_actions(result.world, rec["action"]))
     extras = {
         "seed": result.seed, "attempt": attempts[-1]["attempt"], "sample": attempts[-1]["episode"],
         "instruction": plan.instruction,

@@ -24,6 +24,9 @@ OBS_NORMS = ("min_max", "mean_std")
 DEFAULT_OBSERVATIONS = ("observation.state", "observation.ee_pose", "observation.environment_state")
 REQUIRED_OBSERVATIONS = ("observation.state", "observation.ee_pose")
 ACTION = "action"
+# What a policy can predict: the joint targets (``action``) or the tool's target pose and the gripper
+# (``action.ee_pose``, which the evaluation environment turns into joint targets by IK).
+ACTIONS = (ACTION, "action.ee_pose")
 
 
 def _positive(owner: str, **values: float) -> None:
@@ -91,6 +94,7 @@ class TrainConfig:
     seed: int = 0
     checkpoint_every: int = 1000  # each holds weights, EMA and optimiser: about 20 MB at the default sizes
     observation_keys: tuple[str, ...] | None = None  # None: DEFAULT_OBSERVATIONS the dataset has
+    action_key: str = ACTION  # one of ACTIONS
     obs_norm: str = "min_max"  # observations to [-1, 1] (min_max) or to zero mean, unit std (mean_std)
     rotations: str = "rot6d"  # quaternions read as rotation-matrix columns (see vcage.policy.encoding)
     n_obs_steps: int = 2
@@ -106,6 +110,8 @@ class TrainConfig:
             raise ConfigError(f"unknown policy {self.policy!r}; valid: {', '.join(POLICY_KINDS)}")
         if self.obs_norm not in OBS_NORMS:
             raise ConfigError(f"unknown obs_norm {self.obs_norm!r}; valid: {', '.join(OBS_NORMS)}")
+        if self.action_key not in ACTIONS:
+            raise ConfigError(f"unknown action {self.action_key!r}; valid: {', '.join(ACTIONS)}")
         if self.rotations not in ROTATIONS:
             raise ConfigError(f"unknown rotations {self.rotations!r}; valid: {', '.join(ROTATIONS)}")
         for name in ("steps", "batch_size", "checkpoint_every", "n_obs_steps", "horizon", "n_action_steps"):
@@ -131,9 +137,9 @@ class TrainConfig:
                               f"{2 ** (len(self.diffusion.down_dims) - 1)} for the U-Net's down-sampling")
         if self.observation_keys is not None:
             keys = tuple(str(k) for k in self.observation_keys)
-            if not keys or len(set(keys)) != len(keys) or ACTION in keys:
-                raise ConfigError(f"observation_keys must be distinct feature names other than "
-                                  f"{ACTION!r}, got {self.observation_keys!r}")
+            if not keys or len(set(keys)) != len(keys) or set(keys) & set(ACTIONS):
+                raise ConfigError(f"observation_keys must be distinct feature names other than the "
+                                  f"actions {', '.join(ACTIONS)}, got {self.observation_keys!r}")
             object.__setattr__(self, "observation_keys", keys)
 
     def to_dict(self) -> dict[str, Any]:

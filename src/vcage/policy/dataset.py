@@ -15,8 +15,8 @@ import numpy as np
 
 from vcage.data.reader import DatasetReader
 from vcage.errors import DatasetError
-from vcage.policy.config import ACTION, DEFAULT_OBSERVATIONS, REQUIRED_OBSERVATIONS, TrainConfig
-from vcage.policy.encoding import ObservationEncoder
+from vcage.policy.config import DEFAULT_OBSERVATIONS, REQUIRED_OBSERVATIONS, TrainConfig
+from vcage.policy.encoding import VectorEncoder
 from vcage.policy.errors import MissingFeatureError
 
 MIN_EPISODES = 2
@@ -63,8 +63,9 @@ class DatasetInfo:
 @dataclass(frozen=True, eq=False)
 class TrainingData:
     """All frames of a dataset: ``obs`` (N, obs_dim) float32 (the features of ``obs_features``
-    side by side, as :class:`ObservationEncoder` gives them to the policy), ``action``
-    (N, action_dim) float32, ``lengths`` of the episodes in order."""
+    side by side, as :class:`VectorEncoder` gives them to the policy), ``action``
+    (N, action_dim) float32 (the feature ``action_feature`` encoded the same way), ``lengths`` of
+    the episodes in order."""
 
     obs: np.ndarray
     action: np.ndarray
@@ -88,7 +89,7 @@ def observation_keys(reader: DatasetReader,
     """The observation features to use and notes: ``keys``, or the defaults the dataset has."""
     root = reader.root
     wanted = keys if keys is not None else REQUIRED_OBSERVATIONS
-    for key in (*wanted, ACTION):
+    for key in wanted:
         if key not in reader.features:
             raise MissingFeatureError(
                 f"the dataset {root} has no feature {key!r} (it has {', '.join(sorted(reader.features))}); "
@@ -114,6 +115,10 @@ def load_training_data(root: str | Path, config: TrainConfig) -> TrainingData:
         raise DatasetError(f"the dataset {reader.root} has {reader.num_episodes} episode(s); training needs "
                            f"at least {MIN_EPISODES} (`vcage generate ... --out {reader.root} --episodes N "
                            "--total` adds more)")
+    if config.action_key not in reader.features:
+        raise MissingFeatureError(
+            f"the dataset {reader.root} has no feature {config.action_key!r} to train on (it has "
+            f"{', '.join(sorted(reader.features))}); run `vcage backfill {reader.root}` to add it")
     keys, notes = observation_keys(reader, config.observation_keys)
     obs_parts: list[list[np.ndarray]] = [[] for _ in keys]
     actions, lengths = [], []
@@ -121,15 +126,16 @@ def load_training_data(root: str | Path, config: TrainConfig) -> TrainingData:
         frames = reader.episode(i).frames
         for part, key in zip(obs_parts, keys, strict=True):
             part.append(_vectors(frames[key], key, i, reader.root))
-        actions.append(_vectors(frames[ACTION], ACTION, i, reader.root))
+        actions.append(_vectors(frames[config.action_key], config.action_key, i, reader.root))
         lengths.append(len(actions[-1]))
     specs = tuple(_spec(reader, k) for k in keys)
     raw = np.concatenate([np.concatenate(p) for p in obs_parts], axis=1)
-    obs = ObservationEncoder(specs, config.rotations)(raw)
+    obs = VectorEncoder(specs, config.rotations)(raw)
+    action_spec = _spec(reader, config.action_key)
+    action = VectorEncoder([action_spec], config.rotations)(np.concatenate(actions))
     info = DatasetInfo(str(reader.root), fingerprint(reader), reader.fps, reader.num_episodes,
                        reader.total_frames, reader.config)
-    return TrainingData(obs, np.concatenate(actions), tuple(lengths), specs, _spec(reader, ACTION), info,
-                        tuple(notes))
+    return TrainingData(obs, action, tuple(lengths), specs, action_spec, info, tuple(notes))
 
 
 def _spec(reader: DatasetReader, key: str) -> FeatureSpec:

@@ -1,5 +1,5 @@
-"""How a policy reads its observation features: the stored vectors side by side, with every
-orientation in a form a network can use (no torch).
+"""How a policy reads its observation features and writes its action: the stored vectors side by
+side, with every orientation in a form a network can use (no torch).
 
 Datasets store poses as a position and a unit quaternion ``(w, x, y, z)`` with ``w >= 0``. A
 quaternion is a poor network input: ``q`` and ``-q`` are the same rotation, so the stored sign
@@ -10,6 +10,10 @@ default) every quaternion becomes the first two columns of its rotation matrix (
 "On the Continuity of Rotation Representations in Neural Networks", 2019): continuous, and the
 same for ``q`` and ``-q``. ``"quaternion"`` passes the stored values through (checkpoints written
 before this choice existed).
+
+An action feature with a quaternion (``action.ee_pose``) is encoded the same way for training, and
+the network's output is decoded back (:meth:`VectorEncoder.decode`: the two columns made orthonormal
+by Gram-Schmidt, the third their cross product, then the quaternion with ``w >= 0``).
 
 Quaternions are found by their element names: four consecutive elements named ``qw, qx, qy, qz``,
 each with the same prefix (``bell.qw`` ... ``bell.qz``) or none.
@@ -23,6 +27,7 @@ from typing import Protocol
 import numpy as np
 
 from vcage.errors import ConfigError
+from vcage.geometry import mat_to_quat
 
 ROTATIONS = ("rot6d", "quaternion")
 QUATERNION = ("qw", "qx", "qy", "qz")
@@ -65,8 +70,22 @@ def rot6d(quat: np.ndarray) -> np.ndarray:
                      2 * (x * y - w * z), 1 - 2 * (x * x + z * z), 2 * (y * z + w * x)], axis=-1)
 
 
-class ObservationEncoder:
-    """Stored observation features (side by side, in order) -> the policy's input vector."""
+def rot6d_to_quat(x: np.ndarray) -> np.ndarray:
+    """(..., 6) two rotation-matrix columns, not necessarily orthonormal -> (..., 4) unit quaternions
+    (w, x, y, z) with ``w >= 0`` of the nearest rotation (Gram-Schmidt)."""
+    x = np.asarray(x, dtype=np.float64)
+    a, b = x[..., :3], x[..., 3:6]
+    c1 = a / np.maximum(np.linalg.norm(a, axis=-1, keepdims=True), 1e-12)
+    b = b - np.sum(c1 * b, axis=-1, keepdims=True) * c1
+    c2 = b / np.maximum(np.linalg.norm(b, axis=-1, keepdims=True), 1e-12)
+    c3 = np.cross(c1, c2)
+    flat = np.stack([c1, c2, c3], axis=-1).reshape(-1, 3, 3)  # the columns side by side
+    return np.array([mat_to_quat(m) for m in flat]).reshape(*x.shape[:-1], 4)
+
+
+class VectorEncoder:
+    """Stored vector features (side by side, in order) -> the policy's vector (observation input or
+    action output), and back for actions (:meth:`decode`)."""
 
     def __init__(self, features: Sequence[Feature], rotations: str) -> None:
         if rotations not in ROTATIONS:
@@ -88,12 +107,29 @@ class ObservationEncoder:
         """(..., raw_size) stored values -> (..., size) float32 inputs."""
         x = np.asarray(raw, dtype=np.float32)
         if x.shape[-1] != self.raw_size:
-            raise ValueError(f"expected {self.raw_size} observation values, got {x.shape[-1]}")
+            raise ValueError(f"expected {self.raw_size} values, got {x.shape[-1]}")
         if not self.starts:
             return x
         parts, last = [], 0
         for s in self.starts:
             parts += [x[..., last:s], rot6d(x[..., s:s + 4]).astype(np.float32)]
             last = s + 4
+        parts.append(x[..., last:])
+        return np.concatenate(parts, axis=-1)
+
+    def decode(self, encoded: np.ndarray) -> np.ndarray:
+        """(..., size) policy values -> (..., raw_size) values in the stored form (each rot6d pair of
+        columns back to a unit quaternion)."""
+        x = np.asarray(encoded, dtype=np.float32)
+        if x.shape[-1] != self.size:
+            raise ValueError(f"expected {self.size} encoded values, got {x.shape[-1]}")
+        if not self.starts:
+            return x
+        parts, last, shift = [], 0, 0
+        for s in self.starts:
+            at = s + shift  # where this quaternion's 6 values begin in the encoded vector
+            parts += [x[..., last:at], rot6d_to_quat(x[..., at:at + ROT6D_SIZE]).astype(np.float32)]
+            last = at + ROT6D_SIZE
+            shift += ROT6D_SIZE - 4
         parts.append(x[..., last:])
         return np.concatenate(parts, axis=-1)

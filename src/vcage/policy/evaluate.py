@@ -2,8 +2,10 @@
 
 The environment comes from :func:`vcage.pipeline.evaluation.make_env` with the configuration the
 dataset stored (``meta/vcage.json``), or another dataset's. Before any rollout the checkpoint's
-observation features (names, sizes, element names), action size and control rate are checked
-against the environment's; a difference raises :class:`EnvironmentMismatchError`.
+observation features (names, sizes, element names), action (name and size) and control rate are
+checked against the environment's; a difference raises :class:`EnvironmentMismatchError`. The
+environment is asked for the checkpoint's action (``make_env(..., action=...)``: joint targets, or
+the tool's pose, which it turns into joint targets by IK).
 """
 
 from __future__ import annotations
@@ -25,7 +27,7 @@ from vcage.policy.errors import EnvironmentMismatchError, PolicyError
 from vcage.policy.inference import PolicyRunner, act_together
 from vcage.policy.metrics import subtask_reached, wilson_interval
 
-EnvFactory = Callable[..., gym.Env]  # (config, *, seed, max_steps) -> env, as make_env
+EnvFactory = Callable[..., gym.Env]  # (config, *, seed, max_steps, action) -> env, as make_env
 
 
 @dataclass(frozen=True)
@@ -111,6 +113,9 @@ def check_compatible(checkpoint: Mapping[str, Any], env: gym.Env) -> None:
     if tuple(env.action_space.shape or ()) != (action,):
         problems.append(f"the action is {env.action_space.shape} in the environment, ({action},) in the "
                         "checkpoint")
+    name, env_name = checkpoint["action_feature"]["name"], getattr(env.unwrapped, "action_key", "action")
+    if name != env_name:
+        problems.append(f"the environment takes {env_name!r} as its action, the checkpoint predicts {name!r}")
     fps, env_fps = int(checkpoint["dataset"]["fps"]), env.metadata.get("render_fps")
     if env_fps is not None and int(env_fps) != fps:
         problems.append(f"the environment steps at {env_fps} Hz, the dataset was recorded at {fps} fps")
@@ -247,7 +252,7 @@ def evaluate(checkpoint: str | Path, episodes: int, *, seed: int = 0, max_steps:
         raise PolicyError(f"the dataset {payload['dataset']['path']} the checkpoint was trained on stores no "
                           "vcage configuration (meta/vcage.json), so there is no environment to evaluate in; "
                           "pass the environment of a vcage dataset (--env DATASET)")
-    factory = make_env or default_factory()
+    factory = functools.partial(make_env or default_factory(), action=payload["action_feature"]["name"])
     if scenes is not None:
         if not scenes:
             raise PolicyError("an evaluation on given scenes needs at least one scene seed")

@@ -17,7 +17,7 @@ import torch
 
 from vcage.policy.config import TrainConfig
 from vcage.policy.dataset import FeatureSpec
-from vcage.policy.encoding import ObservationEncoder
+from vcage.policy.encoding import VectorEncoder
 from vcage.policy.errors import PolicyError
 from vcage.policy.models import Policy, make_policy, randn
 from vcage.policy.normalize import Normalizer
@@ -34,9 +34,9 @@ class PolicyRunner:
         self.obs_norm = Normalizer.from_dict(checkpoint["normalization"]["obs"])
         self.action_norm = Normalizer.from_dict(checkpoint["normalization"]["action"])
         self.device = torch.device(device)
-        self.encoder = ObservationEncoder(self.obs_features, self.config.rotations)
-        obs_dim = self.encoder.size
-        self.model: Policy = make_policy(self.config, obs_dim, self.action_feature.size)
+        self.encoder = VectorEncoder(self.obs_features, self.config.rotations)
+        self.action_encoder = VectorEncoder([self.action_feature], self.config.rotations)
+        self.model: Policy = make_policy(self.config, self.encoder.size, self.action_encoder.size)
         try:
             self.model.load_state_dict(checkpoint["ema"]["model"])
         except (RuntimeError, KeyError, TypeError) as exc:
@@ -77,7 +77,8 @@ class PolicyRunner:
 
     def _queue_chunk(self, chunk: np.ndarray) -> None:
         start = self.config.n_obs_steps - 1
-        self._queue.extend(self.action_norm.unnormalize(chunk[start:start + self.config.n_action_steps]))
+        executed = self.action_norm.unnormalize(chunk[start:start + self.config.n_action_steps])
+        self._queue.extend(self.action_encoder.decode(executed))
 
 
 def act_together(runners: Sequence[PolicyRunner],
@@ -94,7 +95,7 @@ def act_together(runners: Sequence[PolicyRunner],
     if due:
         lead = runners[0]
         windows = torch.from_numpy(np.stack([np.stack(r._window) for r in due])).to(lead.device)
-        shape = (1, lead.config.horizon, lead.action_feature.size)
+        shape = (1, lead.config.horizon, lead.action_encoder.size)
         noise = torch.cat([randn(shape, r.generator, windows) for r in due])
         chunks = lead.model.predict_from(windows, noise).cpu().numpy()
         for runner, chunk in zip(due, chunks, strict=True):

@@ -15,6 +15,7 @@ import numpy as np
 
 from vcage.config import SimConfig
 from vcage.errors import SimulationError
+from vcage.geometry import mat_to_quat
 from vcage.sim.robot import PREFIX as ROBOT_PREFIX
 from vcage.sim.robot import Robot
 
@@ -169,6 +170,22 @@ class World:
         quat = scratch.xquat[ids].copy()
         quat[quat[:, 0] < 0] *= -1.0
         return np.column_stack([scratch.xpos[ids], quat])
+
+    def tcp_poses(self, arm_qs: np.ndarray) -> np.ndarray:
+        """(T, 7) tool-centre-point poses (position, quaternion ``w >= 0``) the arm would have at each
+        row of ``arm_qs`` (T, 7), from forward kinematics in the scratch data (the simulation is not
+        touched): e.g. where a sequence of joint targets puts the hand."""
+        if self._scratch is None:
+            self._scratch = mujoco.MjData(self.model)
+        scratch, robot = self._scratch, self.robot
+        scratch.qpos[:] = self.data.qpos
+        out = np.empty((len(arm_qs), 7))
+        for i, q in enumerate(np.asarray(arm_qs, dtype=float)):
+            scratch.qpos[robot.arm_qpos] = q
+            mujoco.mj_kinematics(self.model, scratch)
+            pos, mat = robot.tcp_pose(scratch)
+            out[i] = np.concatenate([pos, mat_to_quat(mat)])
+        return out
 
     def object_pos(self, name: str) -> np.ndarray:
         return self.data.xpos[self.object(name).body_id].copy()

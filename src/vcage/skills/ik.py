@@ -45,9 +45,9 @@ class IKSolver:
                                    lm_damping=1e-3)
         self.posture = mink.PostureTask(self.model, cost=1e-3)
         self.limits = [mink.ConfigurationLimit(self.model, min_distance_from_limits=0.02)]
-        home = np.zeros(self.model.nq)
-        home[:7] = HOME_QPOS
-        self.posture.set_target(home)
+        self._home = np.zeros(self.model.nq)
+        self._home[:7] = HOME_QPOS
+        self.posture.set_target(self._home)
 
     def check_reachable(self, pos: np.ndarray) -> None:
         shoulder = self.mount + [0.0, 0.0, SHOULDER_HEIGHT]
@@ -58,9 +58,10 @@ class IKSolver:
                 f"reaches {MAX_REACH} m: move the object closer to the robot"
             )
 
-    def solve(self, pos: np.ndarray, rot: np.ndarray, seed: np.ndarray) -> np.ndarray:
-        """Arm joint positions (7,) reaching ``pos``/``rot``; raises :class:`IKError` if none."""
-        self.check_reachable(pos)
+    def _descend(self, pos: np.ndarray, rot: np.ndarray, seed: np.ndarray, iters: int, pos_tol: float,
+                 rot_tol: float) -> bool:
+        """Up to ``iters`` solver steps from ``seed`` towards the pose (within the joint limits);
+        whether the errors fell below the tolerances. The configuration reached is ``self.config``."""
         q = np.zeros(self.model.nq)
         q[:7] = seed
         q[7:] = 0.04
@@ -69,19 +70,40 @@ class IKSolver:
                                                         np.asarray(pos))
         self.task.set_target(target)
         dt = 0.05
-        for _ in range(self.max_iters):
+        for _ in range(iters):
             err = self.task.compute_error(self.config)
-            if np.linalg.norm(err[:3]) < self.pos_tol and np.linalg.norm(err[3:]) < self.rot_tol:
-                return self.config.q[:7].copy()
+            if np.linalg.norm(err[:3]) < pos_tol and np.linalg.norm(err[3:]) < rot_tol:
+                return True
             vel = mink.solve_ik(self.config, [self.task, self.posture], dt, solver="daqp",
                                 damping=1e-3, limits=self.limits)
             self.config.integrate_inplace(vel, dt)
+        return False
+
+    def solve(self, pos: np.ndarray, rot: np.ndarray, seed: np.ndarray) -> np.ndarray:
+        """Arm joint positions (7,) reaching ``pos``/``rot``; raises :class:`IKError` if none."""
+        self.check_reachable(pos)
+        if self._descend(pos, rot, seed, self.max_iters, self.pos_tol, self.rot_tol):
+            return self.config.q[:7].copy()
         err = self.task.compute_error(self.config)
         raise IKError(
             f"IK did not converge to {np.round(pos, 3).tolist()}: position error "
             f"{np.linalg.norm(err[:3]) * 1000:.1f} mm, orientation error {np.linalg.norm(err[3:]):.3f} "
             "rad; the pose may be at the edge of the workspace or against a joint limit"
         )
+
+    def track(self, pos: np.ndarray, rot: np.ndarray, seed: np.ndarray, max_iters: int = 50) -> np.ndarray:
+        """Arm joint positions (7,) as close to ``pos``/``rot`` as ``max_iters`` solver steps get from
+        ``seed`` (to a quarter of :meth:`solve`'s tolerances), within the joint limits: a Cartesian
+        controller's joint target. Never raises: an unreachable pose gives the nearest configuration
+        found."""
+        hold = np.zeros(self.model.nq)
+        hold[:7] = seed
+        self.posture.set_target(hold)
+        try:
+            self._descend(pos, rot, seed, max_iters, self.pos_tol / 4, self.rot_tol / 4)
+        finally:
+            self.posture.set_target(self._home)
+        return self.config.q[:7].copy()
 
     def fk(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """TCP position and rotation for arm joints ``q``."""
