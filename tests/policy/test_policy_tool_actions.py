@@ -14,8 +14,9 @@ from vcage.cli import app
 from vcage.data import DatasetReader
 from vcage.errors import ConfigError
 from vcage.pipeline.evaluation import make_env
-from vcage.pipeline.features import ACTION, ACTION_EE
+from vcage.pipeline.features import ACTION, ACTION_EE, ACTIONS
 from vcage.policy.checkpoint import load_checkpoint
+from vcage.policy.config import ACTIONS as POLICY_ACTIONS
 from vcage.policy.config import TrainConfig
 from vcage.policy.dataset import FeatureSpec, load_training_data
 from vcage.policy.encoding import VectorEncoder, rot6d
@@ -57,6 +58,7 @@ def test_a_tool_action_is_encoded_with_rot6d_and_decoded_to_the_same_pose() -> N
 
 
 def test_the_action_is_a_choice_of_the_configuration() -> None:
+    assert POLICY_ACTIONS == ACTIONS  # the policy (torch only) names what the environment takes
     assert TrainConfig().action_key == ACTION
     given = TrainConfig().to_dict()
     del given["action_key"]  # checkpoints written before the choice predict joint targets

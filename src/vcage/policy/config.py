@@ -25,7 +25,8 @@ DEFAULT_OBSERVATIONS = ("observation.state", "observation.ee_pose", "observation
 REQUIRED_OBSERVATIONS = ("observation.state", "observation.ee_pose")
 ACTION = "action"
 # What a policy can predict: the joint targets (``action``) or the tool's target pose and the gripper
-# (``action.ee_pose``, which the evaluation environment turns into joint targets by IK).
+# (``action.ee_pose``, which the evaluation environment turns into joint targets by IK); the same as
+# vcage.pipeline.features.ACTIONS, which this module cannot import (training loads no simulator).
 ACTIONS = (ACTION, "action.ee_pose")
 
 
