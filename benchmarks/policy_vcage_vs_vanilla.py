@@ -136,6 +136,7 @@ def train_config(args: argparse.Namespace, train_seed: int) -> Any:
         DiffusionConfig(down_dims=tuple(args.down_dims))
     return TrainConfig(policy=args.policy, steps=steps, lr=args.lr, seed=train_seed,
                        batch_size=args.batch_size, diffusion=diffusion, action_key=args.action,
+                       observation_keys=tuple(args.obs) if args.obs else None,
                        checkpoint_every=max(1, min(args.checkpoint_every, steps)))
 
 
@@ -373,6 +374,8 @@ def main() -> None:
     parser.add_argument("--policy", choices=("diffusion", "mlp"), default="diffusion")
     parser.add_argument("--action", choices=("action", "action.ee_pose"), default="action",
                         help="what the policies predict: joint targets, or the tool's pose (IK in the env)")
+    parser.add_argument("--obs", nargs="+", default=None,
+                        help="observation features (default: state, tool pose and environment state)")
     parser.add_argument("--steps", type=int, default=15000, help="training steps per checkpoint run")
     parser.add_argument("--lr", type=float, default=1e-3, help="peak learning rate")
     parser.add_argument("--batch-size", type=int, default=64)

@@ -89,7 +89,8 @@ def test_evaluate_on_the_training_scenes_rolls_out_the_datasets_own_scenes(gener
     result = RUN.invoke(app, ["evaluate", str(out), "--episodes", "3", "--max-steps", "4",
                               "--training-scenes", "--json", str(report)])
     assert result.exit_code == 0, result.output
-    assert "has 2 episodes" in flat(result.output) and "training (the dataset's own)" in flat(result.output)
+    text = flat(result.output)
+    assert "the training dataset has 2 scenes" in text and "training (the dataset's own)" in text
     reader = DatasetReader(generated)
     record = json.loads(report.read_text())
     seeds = [e["scene_seed"] for e in record["per_episode"]]
@@ -97,7 +98,23 @@ def test_evaluate_on_the_training_scenes_rolls_out_the_datasets_own_scenes(gener
     held_out = RUN.invoke(app, ["evaluate", str(out), "--episodes", "1", "--max-steps", "4", "--json",
                                 str(report)])
     assert held_out.exit_code == 0, held_out.output
-    assert json.loads(report.read_text())["per_episode"][0]["scene_seed"] not in seeds
+    first = json.loads(report.read_text())["per_episode"][0]["scene_seed"]
+    assert first not in seeds
+    # a fixed list of scenes, as the experiment keeps its held-out ones: episode k on the k-th
+    chosen = tmp_path / "scenes.json"
+    chosen.write_text(json.dumps({"tried": 3, "solved": [first, seeds[1]], "failed": [7]}))
+    listed = RUN.invoke(app, ["evaluate", str(out), "--episodes", "3", "--max-steps", "4", "--scenes",
+                              str(chosen), "--json", str(report)])
+    assert listed.exit_code == 0, listed.output
+    assert "(2 seeds)" in flat(listed.output) and "holds 2 scenes: evaluating on those" in flat(listed.output)
+    assert [e["scene_seed"] for e in json.loads(report.read_text())["per_episode"]] == [first, seeds[1]]
+    for bad in ("[]", "[-1]", '{"solved": "x"}', "not json"):
+        chosen.write_text(bad)
+        refused = RUN.invoke(app, ["evaluate", str(out), "--episodes", "1", "--scenes", str(chosen)])
+        assert refused.exit_code == 2 and "--scenes" in flat(refused.output), bad
+    both = RUN.invoke(app, ["evaluate", str(out), "--episodes", "1", "--scenes", str(report),
+                            "--training-scenes"])
+    assert both.exit_code == 2 and "give one" in flat(both.output)
 
 
 def test_training_scenes_need_a_dataset_that_stores_its_seeds(tmp_path: Path) -> None:

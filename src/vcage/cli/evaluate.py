@@ -10,6 +10,22 @@ from rich.table import Table
 
 from vcage.cli._app import app, console
 from vcage.cli.errors import cli_errors
+from vcage.errors import ConfigError
+
+
+def read_scenes(path: Path) -> list[int]:
+    """Scene seeds from a JSON file: a list of non-negative integers, or an object whose ``solved``
+    is one (the held-out scenes ``benchmarks/policy_vcage_vs_vanilla.py`` keeps in ``eval/``)."""
+    try:
+        data = json.loads(path.read_text())
+    except (OSError, ValueError) as exc:
+        raise ConfigError(f"--scenes {path}: cannot read a JSON file ({exc})") from None
+    seeds = data.get("solved") if isinstance(data, dict) else data
+    if not isinstance(seeds, list) or not seeds or not all(
+            isinstance(s, int) and not isinstance(s, bool) and s >= 0 for s in seeds):
+        raise ConfigError(f"--scenes {path}: expected a non-empty list of scene seeds (non-negative "
+                          "integers), or an object with one under 'solved'")
+    return seeds
 
 
 @app.command("evaluate")
@@ -32,6 +48,10 @@ def evaluate_cmd(
         training_scenes: bool = typer.Option(False, help="roll out on the scenes of the training dataset's "
                                              "first --episodes episodes instead of held-out ones: does the "
                                              "policy reproduce its own demonstrations?"),
+        scenes_file: Path = typer.Option(None, "--scenes",
+                                         help="roll out on the scene seeds in this JSON file (a list, or the "
+                                         "experiment's eval/TASK.json: its 'solved' held-out scenes), "
+                                         "episode k on the k-th; --episodes at most their number"),
         json_out: Path = typer.Option(None, "--json",
                                       help="also write the results to this JSON file")) -> None:
     """Roll out CHECKPOINT for --episodes episodes: success rate (Wilson 95% interval), progress per
@@ -48,10 +68,14 @@ def evaluate_cmd(
         from vcage.errors import DatasetError
 
         raise DatasetError(f"{env} stores no vcage configuration (meta/vcage.json); choose a vcage dataset")
+    if training_scenes and scenes_file is not None:
+        raise ConfigError("--training-scenes and --scenes choose the scenes two ways: give one")
     scenes = scenes_of(load_checkpoint(checkpoint), episodes) if training_scenes else None
+    if scenes_file is not None:
+        scenes = read_scenes(scenes_file)
     if scenes is not None and len(scenes) < episodes:
-        console.print(f"[yellow]note:[/yellow] the training dataset has {len(scenes)} episodes: evaluating "
-                      "on those")
+        where = "the training dataset has" if training_scenes else f"{scenes_file} holds"
+        console.print(f"[yellow]note:[/yellow] {where} {len(scenes)} scenes: evaluating on those")
         episodes = len(scenes)
     bar = Progress(TextColumn("{task.description}"), BarColumn(), TextColumn("{task.completed}/{task.total}"),
                    TimeElapsedColumn(), console=console)
@@ -83,7 +107,8 @@ def evaluate_cmd(
         name = result.subtask_names[i] if i < len(result.subtask_names) else ""
         table.add_row(f"subtask {i + 1} done{': ' + name if name else ''}", f"{share:.1%}")
     table.add_row("rollouts/minute", f"{result.rollouts_per_minute:.2f}")
-    table.add_row("scenes", "training (the dataset's own)" if scenes is not None else "held-out")
+    table.add_row("scenes", "training (the dataset's own)" if training_scenes else
+                  f"{scenes_file} ({len(scenes or [])} seeds)" if scenes_file is not None else "held-out")
     table.add_row("seed", str(seed))
     console.print(table)
     if json_out is not None:
