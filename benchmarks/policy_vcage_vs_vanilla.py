@@ -226,15 +226,20 @@ def train_and_evaluate(task: str, method: str, dataset: Path, env_config: dict[s
                           workers=args.workers, batch=args.eval_batch)
     fit = None
     if args.fit:  # the same checkpoint on scenes of its own training episodes: does it fit its data?
+        from vcage.data import DatasetReader
         from vcage.policy.checkpoint import load_checkpoint
         from vcage.policy.evaluate import training_scenes
 
         own = training_scenes(load_checkpoint(run), args.fit)
-        fit = evaluate(run, len(own), seed=0, max_steps=args.max_steps, env_config=env_config,
-                       threads=args.threads, scenes=own, workers=args.workers, batch=args.eval_batch)
+        # in the environment of its own dataset: a Vanilla episode's seed builds its scene only with
+        # Vanilla's sampler (V-CAGE's would place the same objects elsewhere)
+        fit = evaluate(run, len(own), seed=0, max_steps=args.max_steps,
+                       env_config=DatasetReader(dataset).config, threads=args.threads, scenes=own,
+                       workers=args.workers, batch=args.eval_batch)
     out = evaluation.to_dict() | {"task": task, "method": method, "train_seed": train_seed,
                                   "fit": None if fit is None else {"episodes": len(fit.episodes),
-                                                                   "successes": fit.successes},
+                                                                   "successes": fit.successes,
+                                                                   "environment": str(dataset)},
                                   "eval_batch": args.eval_batch,
                                   "train_seconds": seconds, "train_samples_per_second": rate,
                                   "final_loss": loss}

@@ -33,7 +33,9 @@ def test_the_quick_experiment_runs_end_to_end_and_resumes(tmp_path: Path) -> Non
     results = sorted(p.relative_to(tmp_path).as_posix() for p in (tmp_path / "results").rglob("*.json"))
     assert results == ["results/press_the_bell/vanilla/seed0.json", "results/press_the_bell/vcage/seed0.json"]
     for path in (tmp_path / "results").rglob("*.json"):  # each checkpoint also ran on one training scene
-        assert json.loads(path.read_text())["fit"]["episodes"] == 1
+        fit = json.loads(path.read_text())["fit"]  # of its own dataset, built by that dataset's sampler
+        assert fit["episodes"] == 1 and fit["environment"] == str(tmp_path / "data" / "press_the_bell" /
+                                                                   path.parent.name)
     stamps = {p: p.stat().st_mtime_ns for p in (tmp_path / "results").rglob("*.json")}
     second = run(tmp_path)  # everything is done: read back, nothing generated, trained or evaluated again
     assert "(0 attempts this run)" in second
