@@ -18,8 +18,10 @@ randomisation) and simulator settings as the generation run that made the datase
   absolute arm joint targets and a gripper command in [0, 1], held for one control period
   (1 / ``control_hz``); or ``action.ee_pose``, the tool-centre point's target pose (position,
   quaternion w, x, y, z) and the gripper command, which the environment turns into joint targets by
-  differential inverse kinematics warm-started from the previous step's targets (the joints the
-  recorded demonstrations' poses came from are found again to a fraction of a millimetre).
+  differential inverse kinematics warm-started from the previous step's targets: replaying a
+  demonstration's poses puts the hand on its recorded path, but the elbow, which a pose leaves
+  free on a 7-joint arm, can end up elsewhere than the demonstration's (joint angles up to 0.7 rad
+  apart), so a policy acting in poses should not observe the joint angles.
 * **Success** follows the plan: the subtasks are checked in order, each by the oracle as generation
   checks it (every predicate true on ``HOLD_STEPS`` consecutive control steps; events latched while
   the subtask is the current one). ``info``: ``success``, ``subtasks_done``, ``subtasks``,
