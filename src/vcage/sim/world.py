@@ -49,7 +49,7 @@ class World:
         self.robot = Robot(model)
         self.substeps = sim.substeps
         self.physics_seconds = 0.0  # wall time spent in step(), to relate a run's total to physics
-        self._scratch: mujoco.MjData | None = None  # kinematics off the simulation (object_poses)
+        self._scratch: mujoco.MjData | None = None  # kinematics off the simulation (object_poses, tcp_poses)
         self._root_to_object = np.full(model.nbody, -1, dtype=np.int32)
         self.object_names = list(objects)
         for idx, inst in enumerate(objects.values()):
@@ -159,9 +159,7 @@ class World:
         before integrating); these never do.
         """
         ids = [self.object(n).body_id for n in names]
-        if self._scratch is None:
-            self._scratch = mujoco.MjData(self.model)
-        scratch = self._scratch
+        scratch = self._scratch_data()
         if state is None:
             scratch.qpos[:] = self.data.qpos
         else:
@@ -171,13 +169,17 @@ class World:
         quat[quat[:, 0] < 0] *= -1.0
         return np.column_stack([scratch.xpos[ids], quat])
 
+    def _scratch_data(self) -> mujoco.MjData:
+        """The data in which kinematics are computed off the simulation (made on first use)."""
+        if self._scratch is None:
+            self._scratch = mujoco.MjData(self.model)
+        return self._scratch
+
     def tcp_poses(self, arm_qs: np.ndarray) -> np.ndarray:
         """(T, 7) tool-centre-point poses (position, quaternion ``w >= 0``) the arm would have at each
         row of ``arm_qs`` (T, 7), from forward kinematics in the scratch data (the simulation is not
         touched): e.g. where a sequence of joint targets puts the hand."""
-        if self._scratch is None:
-            self._scratch = mujoco.MjData(self.model)
-        scratch, robot = self._scratch, self.robot
+        scratch, robot = self._scratch_data(), self.robot
         scratch.qpos[:] = self.data.qpos
         out = np.empty((len(arm_qs), 7))
         for i, q in enumerate(np.asarray(arm_qs, dtype=float)):
