@@ -22,6 +22,7 @@ import numpy as np
 import torch
 
 from vcage.policy.checkpoint import load_checkpoint
+from vcage.policy.config import ACTION
 from vcage.policy.devices import torch_device
 from vcage.policy.errors import EnvironmentMismatchError, PolicyError
 from vcage.policy.inference import PolicyRunner, act_together
@@ -113,7 +114,7 @@ def check_compatible(checkpoint: Mapping[str, Any], env: gym.Env) -> None:
     if tuple(env.action_space.shape or ()) != (action,):
         problems.append(f"the action is {env.action_space.shape} in the environment, ({action},) in the "
                         "checkpoint")
-    name, env_name = checkpoint["action_feature"]["name"], getattr(env.unwrapped, "action_key", "action")
+    name, env_name = checkpoint["action_feature"]["name"], getattr(env.unwrapped, "action_key", ACTION)
     if name != env_name:
         problems.append(f"the environment takes {env_name!r} as its action, the checkpoint predicts {name!r}")
     fps, env_fps = int(checkpoint["dataset"]["fps"]), env.metadata.get("render_fps")
