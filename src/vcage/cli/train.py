@@ -26,7 +26,8 @@ def train_cmd(
         checkpoint_every: int = typer.Option(None, help="steps between checkpoints (default 1000)"),
         obs: str = typer.Option(None, help="comma-separated observation features (default: "
                                 "observation.state, observation.ee_pose and observation.environment_state "
-                                "if the dataset has it)"),
+                                "if the dataset has it); FEATURE[ELEMENT,...] observes some elements "
+                                "of a feature by name, e.g. observation.state[gripper_width]"),
         action: str = typer.Option(None, help="what the policy predicts: action (default: the 7 joint "
                                    "targets and the gripper) or action.ee_pose (the tool's target pose "
                                    "and the gripper; evaluation turns it into joint targets by IK)"),
@@ -45,14 +46,13 @@ def train_cmd(
     """Train a policy on DATASET: deterministic on the CPU given --seed, resumable with --resume."""
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn, TimeRemainingColumn
 
-    from vcage.policy.config import TrainConfig
+    from vcage.policy.config import TrainConfig, split_keys
     from vcage.policy.train import stored_config, train
 
     given: dict[str, Any] = {"policy": policy, "steps": steps, "batch_size": batch_size, "lr": lr,
                              "seed": seed, "checkpoint_every": checkpoint_every, "rotations": rotations,
                              "action_key": action,
-                             "observation_keys": tuple(k.strip() for k in obs.split(",") if k.strip())
-                             if obs else None}
+                             "observation_keys": split_keys(obs) if obs else None}
     given = {k: v for k, v in given.items() if v is not None}
     base = stored_config(out) if resume else None
     merged = {**(base.to_dict() if base else {}), **given}

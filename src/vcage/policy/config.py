@@ -11,6 +11,7 @@ current frame on.
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import asdict, dataclass, field
 from typing import Any
 
@@ -28,6 +29,28 @@ ACTION = "action"
 # (``action.ee_pose``, which the evaluation environment turns into joint targets by IK); the same as
 # vcage.pipeline.features.ACTIONS, which this module cannot import (training loads no simulator).
 ACTIONS = (ACTION, "action.ee_pose")
+# An observation key: a feature's name, or its name and some of its elements by name in brackets
+# (``observation.state[gripper_width]``), which the policy then observes alone, in the order given
+_KEY = re.compile(r"([^\[\],\s]+)(?:\[([^\[\]]+)\])?")
+
+
+def split_key(key: str) -> tuple[str, tuple[str, ...] | None]:
+    """The feature an observation key reads and the elements it selects (None: all of them)."""
+    match = _KEY.fullmatch(str(key).strip())
+    if match is None:
+        raise ConfigError(f"observation key {key!r} is neither a feature name nor FEATURE[ELEMENT,...] "
+                          "(e.g. observation.state[gripper_width])")
+    if match.group(2) is None:
+        return match.group(1), None
+    elements = tuple(e.strip() for e in match.group(2).split(","))
+    if not all(elements) or len(set(elements)) != len(elements):
+        raise ConfigError(f"observation key {key!r} must name distinct elements between its brackets")
+    return match.group(1), elements
+
+
+def split_keys(text: str) -> tuple[str, ...]:
+    """Comma-separated observation keys (a comma between brackets separates elements, not keys)."""
+    return tuple(k.strip() for k in re.split(r",(?![^\[]*\])", text) if k.strip())
 
 
 def _positive(owner: str, **values: float) -> None:
@@ -137,10 +160,11 @@ class TrainConfig:
             raise ConfigError(f"horizon {self.horizon} must be divisible by 2 ** (levels - 1) = "
                               f"{2 ** (len(self.diffusion.down_dims) - 1)} for the U-Net's down-sampling")
         if self.observation_keys is not None:
-            keys = tuple(str(k) for k in self.observation_keys)
-            if not keys or len(set(keys)) != len(keys) or set(keys) & set(ACTIONS):
-                raise ConfigError(f"observation_keys must be distinct feature names other than the "
-                                  f"actions {', '.join(ACTIONS)}, got {self.observation_keys!r}")
+            keys = tuple(str(k).strip() for k in self.observation_keys)
+            if not keys or len(set(keys)) != len(keys) or {split_key(k)[0] for k in keys} & set(ACTIONS):
+                raise ConfigError(f"observation_keys must be distinct feature names (or "
+                                  f"FEATURE[ELEMENT,...]) other than the actions {', '.join(ACTIONS)}, got "
+                                  f"{self.observation_keys!r}")
             object.__setattr__(self, "observation_keys", keys)
 
     def to_dict(self) -> dict[str, Any]:

@@ -15,7 +15,7 @@ import numpy as np
 
 from vcage.data.reader import DatasetReader
 from vcage.errors import DatasetError
-from vcage.policy.config import DEFAULT_OBSERVATIONS, REQUIRED_OBSERVATIONS, TrainConfig
+from vcage.policy.config import DEFAULT_OBSERVATIONS, REQUIRED_OBSERVATIONS, TrainConfig, split_key
 from vcage.policy.encoding import VectorEncoder
 from vcage.policy.errors import MissingFeatureError
 
@@ -24,19 +24,36 @@ MIN_EPISODES = 2
 
 @dataclass(frozen=True)
 class FeatureSpec:
-    """A vector feature as a policy uses it: name, size and element names (if the dataset has them)."""
+    """A vector feature as a policy uses it: name (the observation key), size and element names (if
+    the dataset has them). A key that selects elements (``observation.state[gripper_width]``) reads
+    feature ``source`` and keeps the values at ``indices``."""
 
     name: str
     size: int
     names: tuple[str, ...] | None = None
+    source: str | None = None  # the dataset's (and environment's) feature, when it differs from name
+    indices: tuple[int, ...] | None = None  # the elements kept, in the source feature; None: all
+
+    @property
+    def feature(self) -> str:
+        return self.source or self.name
+
+    def select(self, values: np.ndarray) -> np.ndarray:
+        """(..., source size) values of the source feature -> (..., size) the policy observes."""
+        return values if self.indices is None else values[..., list(self.indices)]
 
     def to_dict(self) -> dict[str, Any]:
-        return {"name": self.name, "size": self.size, "names": list(self.names) if self.names else None}
+        out: dict[str, Any] = {"name": self.name, "size": self.size,
+                               "names": list(self.names) if self.names else None}
+        if self.indices is not None:
+            out.update(source=self.source, indices=list(self.indices))
+        return out
 
     @classmethod
     def from_dict(cls, data: dict[str, Any]) -> FeatureSpec:
-        names = data.get("names")
-        return cls(str(data["name"]), int(data["size"]), tuple(names) if names else None)
+        names, indices = data.get("names"), data.get("indices")
+        return cls(str(data["name"]), int(data["size"]), tuple(names) if names else None,
+                   data.get("source"), tuple(int(i) for i in indices) if indices is not None else None)
 
 
 @dataclass(frozen=True)
@@ -90,9 +107,10 @@ def observation_keys(reader: DatasetReader,
     root = reader.root
     wanted = keys if keys is not None else REQUIRED_OBSERVATIONS
     for key in wanted:
-        if key not in reader.features:
+        if split_key(key)[0] not in reader.features:
             raise MissingFeatureError(
-                f"the dataset {root} has no feature {key!r} (it has {', '.join(sorted(reader.features))}); "
+                f"the dataset {root} has no feature {split_key(key)[0]!r} (it has "
+                f"{', '.join(sorted(reader.features))}); "
                 f"run `vcage backfill {root}` to add the features policies train on"
                 + ("" if keys is None else ", or choose other observation features"))
     if keys is not None:
@@ -120,15 +138,15 @@ def load_training_data(root: str | Path, config: TrainConfig) -> TrainingData:
             f"the dataset {reader.root} has no feature {config.action_key!r} to train on (it has "
             f"{', '.join(sorted(reader.features))}); run `vcage backfill {reader.root}` to add it")
     keys, notes = observation_keys(reader, config.observation_keys)
+    specs = tuple(_spec(reader, k) for k in keys)
     obs_parts: list[list[np.ndarray]] = [[] for _ in keys]
     actions, lengths = [], []
     for i in range(reader.num_episodes):
         frames = reader.episode(i).frames
-        for part, key in zip(obs_parts, keys, strict=True):
-            part.append(_vectors(frames[key], key, i, reader.root))
+        for part, spec in zip(obs_parts, specs, strict=True):
+            part.append(spec.select(_vectors(frames[spec.feature], spec.feature, i, reader.root)))
         actions.append(_vectors(frames[config.action_key], config.action_key, i, reader.root))
         lengths.append(len(actions[-1]))
-    specs = tuple(_spec(reader, k) for k in keys)
     raw = np.concatenate([np.concatenate(p) for p in obs_parts], axis=1)
     obs = VectorEncoder(specs, config.rotations)(raw)
     action_spec = _spec(reader, config.action_key)
@@ -139,8 +157,17 @@ def load_training_data(root: str | Path, config: TrainConfig) -> TrainingData:
 
 
 def _spec(reader: DatasetReader, key: str) -> FeatureSpec:
-    feature = reader.features[key]
-    return FeatureSpec(key, int(feature.shape[0]), tuple(feature.names) if feature.names else None)
+    source, elements = split_key(key)
+    feature = reader.features[source]
+    names = tuple(feature.names) if feature.names else None
+    if elements is None:
+        return FeatureSpec(key, int(feature.shape[0]), names)
+    missing = [e for e in elements if not names or e not in names]
+    if missing:
+        raise MissingFeatureError(f"the dataset {reader.root}'s feature {source!r} has no element(s) "
+                                  f"{', '.join(missing)} (it has {', '.join(names or ('no names',))})")
+    assert names is not None
+    return FeatureSpec(key, len(elements), elements, source, tuple(names.index(e) for e in elements))
 
 
 def _vectors(values: np.ndarray, key: str, episode: int, root: Path) -> np.ndarray:

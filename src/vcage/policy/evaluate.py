@@ -23,6 +23,7 @@ import torch
 
 from vcage.policy.checkpoint import load_checkpoint
 from vcage.policy.config import ACTION
+from vcage.policy.dataset import FeatureSpec
 from vcage.policy.devices import torch_device
 from vcage.policy.errors import EnvironmentMismatchError, PolicyError
 from vcage.policy.inference import PolicyRunner, act_together
@@ -94,21 +95,28 @@ def check_compatible(checkpoint: Mapping[str, Any], env: gym.Env) -> None:
     space = env.observation_space
     spaces = getattr(space, "spaces", {})
     env_features = getattr(env.unwrapped, "features", {})
-    for feature in checkpoint["obs_features"]:
-        name, size = feature["name"], int(feature["size"])
+    for data in checkpoint["obs_features"]:
+        spec = FeatureSpec.from_dict(data)
+        name = spec.feature
         if name not in spaces:
             problems.append(f"the environment has no observation {name!r} (it has "
                             f"{', '.join(sorted(spaces))})")
             continue
         shape = tuple(spaces[name].shape or ())
-        if shape != (size,):
-            problems.append(f"observation {name!r} is {shape} in the environment, ({size},) in the "
+        env_names = getattr(env_features.get(name), "names", None)
+        if spec.indices is not None:  # some elements of the feature, by name
+            if not env_names or len(shape) != 1 or max(spec.indices) >= shape[0] \
+                    or [env_names[i] for i in spec.indices] != list(spec.names or ()):
+                problems.append(f"observation {spec.name!r} reads elements {list(spec.names or ())} of "
+                                f"{name!r}, which the environment does not have at the same places")
+            continue
+        if shape != (spec.size,):
+            problems.append(f"observation {name!r} is {shape} in the environment, ({spec.size},) in the "
                             "checkpoint")
             continue
-        env_names = getattr(env_features.get(name), "names", None)
-        if feature.get("names") and env_names and list(env_names) != list(feature["names"]):
+        if spec.names and env_names and list(env_names) != list(spec.names):
             problems.append(f"observation {name!r} has elements {list(env_names)[:4]}... in the "
-                            f"environment, {list(feature['names'])[:4]}... in the checkpoint (other "
+                            f"environment, {list(spec.names)[:4]}... in the checkpoint (other "
                             "objects or order)")
     action = int(checkpoint["action_feature"]["size"])
     if tuple(env.action_space.shape or ()) != (action,):

@@ -61,7 +61,7 @@ class PolicyRunner:
 
     def observation_vector(self, obs: Mapping[str, Any]) -> np.ndarray:
         """The policy's input for an environment observation: its features side by side, encoded."""
-        return self.encoder(np.concatenate([np.asarray(obs[f.name], dtype=np.float32).reshape(-1)
+        return self.encoder(np.concatenate([f.select(np.asarray(obs[f.feature], dtype=np.float32).reshape(-1))
                                             for f in self.obs_features]))
 
     def act(self, obs: Mapping[str, Any]) -> np.ndarray:
