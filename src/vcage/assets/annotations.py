@@ -68,7 +68,9 @@ class FunctionalPoint:
     ``joint`` names the object's joint that moves when the function is used (relative name), and
     ``travel`` how far it must move (metres or radians) to count as used. ``stroke`` is how far
     the point itself moves down over one full use (metres, object frame): the press depth a skill
-    needs, whether the joint slides (a button) or turns (a lever, a rocker).
+    needs, whether the joint slides (a button) or turns (a lever, a rocker). For a ``handle`` (a
+    drawer's), ``direction`` is the way the drawer comes out and ``stroke`` how far the skill
+    that opens it pulls it (:mod:`vcage.skills.drawers`).
     """
 
     name: str

@@ -163,6 +163,7 @@ HANDLE_STANDOFF, HANDLE_Z = 0.055, 0.045
 CAB_X0 = (0.004 + HANDLE_STANDOFF + 0.006) / 2  # half the handle's reach beyond the shell
 DRAWER_RANGE = (-0.14, 0.0)  # pulled out (negative) to closed
 DRAWER_TRAVEL = 0.08  # pulled out at least this far counts as open
+DRAWER_PULL = 0.12  # how far the open_drawer skill pulls it out
 _FRONT_X = -CAB_HALF[0] - 0.004 + CAB_X0  # the drawer front's outer face
 _HANDLE_X = _FRONT_X - HANDLE_STANDOFF
 DRAWER_CX = _FRONT_X + 0.008 + DRAWER_INNER[0]  # centre of the drawer's inside, shut
@@ -209,7 +210,7 @@ CATALOG.add_type(ObjectType(
         placements=(Placement("inside", "in", (round(DRAWER_CX, 4), 0, DRAWER_FLOOR), DRAWER_INNER,
                               DRAWER_WALL),),
         functional_points=(FunctionalPoint("handle", "handle", (round(_HANDLE_X, 4), 0, HANDLE_Z),
-                                           joint="drawer", travel=DRAWER_TRAVEL,
+                                           joint="drawer", travel=DRAWER_TRAVEL, stroke=DRAWER_PULL,
                                            direction=(-1.0, 0.0, 0.0)),),
     ),
 ))

@@ -12,7 +12,7 @@ from vcage.scene.spec import ROBOT_MOUNT
 from vcage.sim.world import World
 from vcage.tasks.templates import heading, turn_to_align
 
-__all__ = ["functional_pos", "heading", "local_xy", "top_of", "turn_to_align", "turn_to_face_robot"]
+__all__ = ["heading", "local_xy", "top_of", "turn_to_align", "turn_to_face_robot"]
 
 
 def local_xy(world: World, host: str, local: tuple[float, float]) -> tuple[float, float]:
@@ -40,12 +40,3 @@ def top_of(world: World, obj: str) -> float:
     return float(world.object_pos(obj)[2] + CATALOG.get(inst.type_name).size[2] * inst.scale)
 
 
-def functional_pos(world: World, obj: str, point: str | None = None) -> np.ndarray:
-    """World position of ``obj``'s functional point now, following its joint when it slides along
-    the object's x axis (a drawer's handle)."""
-    inst = world.object(obj)
-    fp = CATALOG.get(inst.type_name).functional_point(point)
-    local = np.asarray(fp.pos, float) * inst.scale
-    if fp.joint is not None and fp.kind == "handle":
-        local = local + [world.joint_value(f"{obj}/{fp.joint}"), 0.0, 0.0]
-    return world.object_pos(obj) + world.object_mat(obj) @ local

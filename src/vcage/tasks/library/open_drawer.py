@@ -9,9 +9,6 @@ from vcage.sim.world import World
 from vcage.skills.base import Skills
 from vcage.tasks import predicates as P
 from vcage.tasks.base import TASKS, AtomicTask, Item
-from vcage.tasks.library._drawer import slide_drawer
-
-OPENING = 0.12  # how far the expert pulls the drawer out
 
 
 @TASKS.register("open_drawer")
@@ -23,7 +20,7 @@ class OpenDrawer(AtomicTask):
         return {"color": self.color_of("cabinet")}
 
     def expert(self, skills: Skills) -> None:
-        slide_drawer(skills, "cabinet", OPENING)
+        skills.do("open_drawer", obj="cabinet")  # to the handle's stroke, 12 cm
         skills.do("retreat")
 
     def evaluate(self, world: World) -> dict[str, Any]:

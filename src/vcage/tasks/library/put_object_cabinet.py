@@ -10,9 +10,9 @@ import numpy as np
 from vcage.assets.objects.tools import CAB_HALF, CAB_X0
 from vcage.sim.world import World
 from vcage.skills.base import Skills
+from vcage.skills.drawers import opening
 from vcage.tasks import predicates as P
 from vcage.tasks.base import TASKS, AtomicTask, Item
-from vcage.tasks.library._drawer import slide_drawer
 from vcage.tasks.library._support import local_xy, turn_to_align
 
 OBJECTS = ("sponge", "soap")  # low enough to pass under the cabinet's top
@@ -35,8 +35,8 @@ class PutObjectCabinet(AtomicTask):
 
     def expert(self, skills: Skills) -> None:
         world = skills.world
-        slide_drawer(skills, "cabinet", OPENING)
-        out = -world.joint_value("cabinet/drawer")  # the drawer has come out by this much
+        skills.do("open_drawer", obj="cabinet", distance=OPENING)
+        out = opening(world, "cabinet")  # the drawer has come out by this much
         # the middle of the drawer's uncovered part: between its front and the cabinet's top
         front = CAB_X0 - CAB_HALF[0] - 0.004 - out
         x = (front + CAB_X0 - CAB_HALF[0]) / 2
@@ -45,7 +45,7 @@ class PutObjectCabinet(AtomicTask):
         turn = turn_to_align(world, "object", "cabinet") + math.pi / 2  # long side across the drawer
         skills.do("turn_and_place", obj="object", turn=math.remainder(2 * turn, 2 * math.pi) / 2,
                   xy=local_xy(world, "cabinet", (x, 0.0)))
-        slide_drawer(skills, "cabinet", -0.005)
+        skills.do("close_drawer", obj="cabinet")
         skills.do("retreat")
 
     def evaluate(self, world: World) -> dict[str, Any]:
