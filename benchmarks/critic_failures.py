@@ -161,8 +161,11 @@ def jobs(goals: Iterable[str], seeds: int, faults_per_seed: int, cache: str | No
             names = faults_for(sub.skill)
             for seed in range(first_seed, first_seed + seeds):
                 out.append((goal, i, seed, None, cache))
-                for k in range(faults_per_seed if names else 0):  # rotate through the faults, seed by seed
-                    out.append((goal, i, seed, names[(seed * faults_per_seed + k + i) % len(names)], cache))
+                # rotate through the faults, seed by seed (each once per seed: a skill with one fault
+                # gives one faulty rollout per seed, not the same one twice)
+                picked = [names[(seed * faults_per_seed + k + i) % len(names)]
+                          for k in range(faults_per_seed if names else 0)]
+                out.extend((goal, i, seed, name, cache) for name in dict.fromkeys(picked))
     return out
 
 

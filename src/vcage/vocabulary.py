@@ -57,6 +57,8 @@ _predicate("upright", 1, 1, "the object stands in its upright orientation (not t
 _predicate("lifted", 1, 1, "the object is held at least 5 cm above the table")
 _predicate("released", 1, 1, "the hand no longer holds the object")
 _predicate("pressed", 1, 1, "the object's button or lever was pressed during the subtask", Kind.EVENT)
+_predicate("opened", 1, 1, "the object's drawer is pulled out at least as far as counts as open")
+_predicate("closed", 1, 1, "the object's drawer is pushed shut")
 
 
 @dataclass(frozen=True)
@@ -120,3 +122,6 @@ _skill("grasp", "Approach ``obj`` from above along its best reachable grasp anno
 _skill("retreat", "Move up to the safe height, then (optionally) back to the home posture.",
        _opt("home", True))
 _skill("open_gripper", "Open the hand fully where it is.")
+_skill("open_drawer", "Pull ``obj``'s drawer out by its handle to ``distance`` metres (default: the "
+       "handle's stroke).", _obj("obj"), _opt("point"), _opt("distance"))
+_skill("close_drawer", "Push ``obj``'s drawer shut by its handle.", _obj("obj"), _opt("point"))

@@ -43,18 +43,22 @@ class Run:
         return self.outcome.oracle_success
 
 
-def run(objects: tuple[ObjectSpec, ...], subtask: Subtask, fault: str | None = None, seed: int = 0) -> Run:
-    """Execute ``subtask`` in a scene of ``objects`` with ``fault`` injected into its skill."""
+def run(objects: tuple[ObjectSpec, ...], subtask: Subtask, fault: str | None = None, seed: int = 0,
+        before: tuple[Subtask, ...] = ()) -> Run:
+    """Execute ``subtask`` in a scene of ``objects`` with ``fault`` injected into its skill, after the
+    subtasks ``before`` (done as planned; their skills must differ from its own)."""
     world = compose(SceneSpec(objects=objects)).make_world()
     world.settle(0.3)
     plan = Plan(instruction="test", objects=tuple(PlanObject(name=o.name, type=o.type) for o in objects),
-                subtasks=(subtask,))
+                subtasks=(*before, subtask))
+    assert all(st.skill != subtask.skill for st in before)
     injector = FaultInjector(FaultConfig(fault, subtask.skill, 0, seed)) if fault else None
     skills = Skills(world, Player(world, record_states=True), fault=injector)
     keep = Keep()
     with Renderer(world, 320, 240) as renderer:
         verifier = Verifier(world, plan, keep, renderer, skills.player.recording, Timing())
         rollout = run_plan(world, plan, skills, verifier)
-    outcome = rollout.outcomes[0]
-    assert outcome.skill_error is None, outcome.skill_error
-    return Run(keep.seen[0], outcome, injector is None or injector.applied)
+    outcome = rollout.outcomes[-1]
+    assert len(rollout.outcomes) == len(plan.subtasks) and outcome.skill_error is None, outcome.skill_error
+    assert all(o.oracle_success for o in rollout.outcomes[:-1]), rollout.outcomes
+    return Run(keep.seen[-1], outcome, injector is None or injector.applied)

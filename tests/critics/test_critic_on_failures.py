@@ -16,7 +16,7 @@ import pytest
 from critics.faulted import Run, run
 from vcage.critics.image import ROBOT, ImageCritic
 from vcage.critics.masks import touch
-from vcage.planning.goals import press, put_in, put_on
+from vcage.planning.goals import close_drawer, open_drawer, press, put_in, put_on
 from vcage.planning.schema import Predicate, Subtask
 from vcage.scene.compose import compose
 from vcage.scene.spec import ObjectSpec as O
@@ -43,6 +43,7 @@ TWO_BLOCKS = (O("a", "block", (0.5, -0.15)), O("b", "block", (0.55, 0.1)))
 STACK = (O("a", "block", (0.5, -0.12)), O("b", "block", (0.55, 0.1)))
 ROW_LEFT = (O("a", "block", (0.5, -0.1)), O("b", "block", (0.55, 0.05)))
 ROW_RIGHT = (O("a", "block", (0.5, 0.1)), O("b", "block", (0.55, -0.05)))
+CABINET = (O("cab", "cabinet", (0.68, 0.05), yaw=-0.2),)
 
 SCENARIOS: dict[str, tuple[tuple[O, ...], Subtask]] = {
     "on": (BLOCK_PAD, put_on("block", "pad", "the block is on the pad")),
@@ -64,7 +65,10 @@ SCENARIOS: dict[str, tuple[tuple[O, ...], Subtask]] = {
                                ("left_of", ("a", "b")), ("released", ("a",)))),
     "right_of": (ROW_RIGHT, _sub("pick_and_place", {"obj": "a", "xy": [0.5, -0.18]},
                                  ("right_of", ("a", "b")), ("released", ("a",)))),
+    "opened": (CABINET, open_drawer("cab", "the drawer is open")),
+    "closed": (CABINET, close_drawer("cab", "the drawer is shut")),  # after opening it (BEFORE)
 }
+BEFORE = {"closed": (open_drawer("cab", "the drawer is open"),)}
 
 # (scenario, fault, seed, the predicate that must fail in the oracle and in the critic's checks)
 FAILURES = [
@@ -90,12 +94,14 @@ FAILURES = [
     ("stacked", "off_target", 0, "stacked(b, a)"),
     ("left_of", "wrong_object", 0, "left_of(a, b)"),
     ("right_of", "wrong_object", 0, "right_of(a, b)"),
+    ("opened", "pull_short", 1, "opened(cab)"),
+    ("closed", "pull_short", 2, "closed(cab)"),
 ]
 
 
 def _run(scenario: str, fault: str | None = None, seed: int = 0) -> Run:
     objects, subtask = SCENARIOS[scenario]
-    return run(objects, subtask, fault, seed)
+    return run(objects, subtask, fault, seed, BEFORE.get(scenario, ()))
 
 
 @pytest.mark.parametrize("scenario", sorted(SCENARIOS))

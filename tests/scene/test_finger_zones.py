@@ -186,3 +186,34 @@ def test_what_rests_in_a_target_keeps_clear_of_the_room_it_receives_in(reach):
         LayoutObject("apple", "apple", support=Support("basket"), grasped=False)))
     with pytest.raises(PlacementError, match="basket"):
         place(crowded, np.random.default_rng(0), config=PlacementConfig(), reach=reach)
+
+
+def test_a_drawer_the_plan_slides_faces_the_robot_and_nothing_stands_where_it_comes_out(reach):
+    from vcage.pipeline.plan_layout import WORK_AREA, plan_layout
+    from vcage.planning import make_planner
+    from vcage.planning.config import PlannerConfig
+    from vcage.scene.placement.geometry import drawer_zone
+
+    plan = make_planner(PlannerConfig()).plan("clear the washstand")
+    layout = plan_layout(plan, np.random.default_rng(0), Randomization(), clutter=6)
+    cabinet = next(o for o in layout.objects if o.type == "cabinet")
+    assert cabinet.slides == pytest.approx(0.12)
+    assert all(o.slides == 0 for o in layout.objects if o is not cabinet)
+    assert -0.5 < cabinet.yaw[0] < cabinet.yaw[1] < 0.5  # its handle (on its -x side) towards the robot
+    counts = {True: 0, False: 0}
+    for zones in (True, False):
+        for seed in range(6):
+            placed = place(layout, np.random.default_rng(seed), config=PlacementConfig(finger_zones=zones),
+                           reach=reach).scene
+            cab = next(o for o in placed.objects if o.name == cabinet.name)
+            zone = drawer_zone("cabinet", cab.scale, cab.yaw, 0.12, cab.xy)
+            front = cab.xy[0] - (0.1025 + 0.12) * math.cos(cab.yaw)  # the drawer's front, out 12 cm
+            assert zone.area > 0.0 and front >= WORK_AREA.bounds[0] - 1e-9, seed
+            counts[zones] += sum(footprint(o.type, o.scale, o.yaw, o.xy).intersects(zone)
+                                 for o in placed.objects if o.name != cab.name)
+    assert counts[True] == 0 < counts[False]
+    # the zone is the drawer's sweep: as wide as the cabinet, from its front towards -x at yaw 0
+    z = drawer_zone("cabinet", 1.0, 0.0, 0.12, (0.7, 0.0))
+    x0, y0, x1, y1 = z.bounds
+    assert x1 == pytest.approx(0.7 - 0.1025) and x0 == pytest.approx(0.7 - 0.1025 - 0.12 - R.FINGER_OUTER)
+    assert (y0, y1) == (pytest.approx(-0.11), pytest.approx(0.11))

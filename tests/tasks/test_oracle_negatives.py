@@ -122,3 +122,31 @@ def test_near_is_false_beyond_ten_centimetres() -> None:
                      ObjectSpec("c", "block", (0.5, -0.115)))
     assert _value(world, "near", "a", "b") and _value(world, "near", "b", "a")
     assert not _value(world, "near", "a", "c") and not _value(world, "near", "b", "c")
+
+
+def test_a_drawer_is_open_from_its_travel_on_shut_within_a_centimetre_and_a_bell_has_neither() -> None:
+    world = _settled(ObjectSpec("cab", "cabinet", (0.68, 0.0)), ObjectSpec("bell", "bell", (0.5, 0.2)))
+    skills = Skills(world)
+    assert (_value(world, "opened", "cab"), _value(world, "closed", "cab")) == (False, True)
+    states = {}
+    for out in (0.05, 0.12):  # short of the 8 cm that count as open, then the skill's full pull
+        skills.do("open_drawer", obj="cab", distance=out)
+        states[out] = (_value(world, "opened", "cab"), _value(world, "closed", "cab"))
+    assert states == {0.05: (False, False), 0.12: (True, False)}
+    skills.do("close_drawer", obj="cab")
+    assert (_value(world, "opened", "cab"), _value(world, "closed", "cab")) == (False, True)
+    assert not _value(world, "opened", "bell") and not _value(world, "closed", "bell")
+
+
+def test_what_lies_in_an_open_drawer_is_inside_it_and_comes_back_in_with_it() -> None:
+    world = _settled(ObjectSpec("cab", "cabinet", (0.68, 0.0)), ObjectSpec("soap", "soap", (0.5, 0.2)))
+    skills = Skills(world)
+    skills.do("pick_and_place", obj="soap", target="cab")  # into the shut drawer: lands on the cabinet
+    assert not _value(world, "inside", "soap", "cab")
+    world = _settled(ObjectSpec("cab", "cabinet", (0.68, 0.0)), ObjectSpec("soap", "soap", (0.5, 0.2)))
+    skills = Skills(world)
+    skills.do("open_drawer", obj="cab")
+    skills.do("pick_and_place", obj="soap", target="cab")  # the region came out with the drawer
+    assert _value(world, "inside", "soap", "cab")
+    skills.do("close_drawer", obj="cab")
+    assert _value(world, "inside", "soap", "cab") and _value(world, "closed", "cab")

@@ -38,6 +38,11 @@ simulator state. Each predicate is checked in image space:
   measured with the orthographic view's pixel size.
 - ``lifted(a)``: in the front view ``a``'s lowest row rose by at least :data:`LIFT_ROWS` pixels
   since before the subtask, and it is not over another object's top-view hull (it hangs in the air).
+- ``opened(x)`` / ``closed(x)``: how far ``x``'s drawer is out, from the top view after the
+  subtask: the sides of the smallest rectangle around ``x``'s outline, together, less its type's
+  footprint (the object shut; the drawer is narrower than the body, so only the side it slides along
+  grows); open from the handle's travel on, shut under :data:`SHUT_OUT`. Where the robot hides part
+  of ``x`` a drawer is not judged shut.
 
 Every predicate of :mod:`vcage.vocabulary` has a check in ``IMAGE_CHECKS``. Without the top view's
 depth (or the object's type), a press that touches the button but moves it less than its travel (a
@@ -52,7 +57,18 @@ import numpy as np
 
 from vcage.assets.catalog import CATALOG
 from vcage.critics.base import CRITICS, Critic, CriticConfig, Observation, Verdict, View
-from vcage.critics.masks import TOUCH, best_shift, centroid_in, dilate, hull, rows_of, shift, spread, touch
+from vcage.critics.masks import (
+    TOUCH,
+    best_shift,
+    centroid_in,
+    dilate,
+    hull,
+    rectangle_sides,
+    rows_of,
+    shift,
+    spread,
+    touch,
+)
 from vcage.registry import Registry
 
 ROBOT = -2
@@ -103,6 +119,10 @@ BUTTON_COVER = 0.8
 # Metres by which an object below the hand's lowest pixel in the front view must be nearer the camera
 # than the hand to hide where the hand goes down (a cup's rim 1.3 cm in front of the fingers was seen)
 NEARER = 0.005
+# How far out (metres) a drawer may look in the top view and count as shut: the oracle's 1 cm and
+# the estimate's excess (0.2-0.9 cm on renders of the cabinet 0-14 cm out at four headings, where
+# nothing hid it; a pixel is 3.7 mm)
+SHUT_OUT = 0.015
 
 
 class ImageCritic(Critic):
@@ -441,6 +461,55 @@ def _hidden(view: View, mask: np.ndarray) -> int:
     return int(((view.segmentation == ROBOT) & dilate(hull(mask), TOUCH + 1)).sum())
 
 
+def _drawer(obs: Observation, x: str) -> tuple[float, float, bool] | str:
+    """How far ``x``'s drawer is out after the subtask, by the top view, the travel that counts as
+    open (both in metres) and whether the robot hides part of ``x``; or why it cannot be told.
+
+    The type's footprint is the object shut, handle included, and its drawer is narrower than the
+    body: pulled out, only the side along which it slides grows. So the smallest rectangle around
+    the outline is longer than the footprint, both sides together, by how far the drawer is out
+    (the size scaled by the object's height over its type's).
+    """
+    after = obs.after.get(TOP)
+    otype = CATALOG.get(obs.types[x]) if x in obs.types and obs.types[x] in CATALOG else None
+    if after is None or otype is None:
+        return f"the top view after the subtask and {x}'s type are needed"
+    handles = [p for p in otype.functional_points if p.kind == "handle" and p.joint]
+    if not handles:
+        return f"{x} ({otype.name}) has no drawer"
+    point = next((p for p in handles if p.name == obs.subtask.args.get("point")), handles[0])
+    heights, mask = _heights(after), _mask(obs, after, x)
+    if heights is None or after.pixel_size is None or mask.sum() < MIN_RELIEF_PX:
+        return f"{x} is not seen in the top view's heights"
+    scale = float(heights[_inner(mask)].max()) / otype.size[2]
+    long, short = rectangle_sides(mask)
+    out = (long + short) * after.pixel_size - (otype.size[0] + otype.size[1]) * scale
+    return out, point.travel * scale, _hidden(after, mask) > 0
+
+
+def _opened(obs: Observation, x: str) -> tuple[bool, str]:
+    drawer = _drawer(obs, x)
+    if isinstance(drawer, str):
+        return False, drawer
+    out, travel, hidden = drawer
+    if out >= travel:
+        return True, "opened"
+    why = f"{x}'s drawer is out about {100 * out:.1f} cm in the top view, less than the {100 * travel:.0f} cm"
+    return False, why + " that count as open" + (" (the robot hides part of it)" if hidden else "")
+
+
+def _closed(obs: Observation, x: str) -> tuple[bool, str]:
+    drawer = _drawer(obs, x)
+    if isinstance(drawer, str):
+        return False, drawer
+    out, _, hidden = drawer
+    if hidden:
+        return False, f"the robot hides part of {x} in the top view: its drawer may stand out"
+    if out > SHUT_OUT:
+        return False, f"{x}'s drawer is out about {100 * out:.1f} cm in the top view, not shut"
+    return True, "closed"
+
+
 def _upright(obs: Observation, x: str) -> tuple[bool, str]:
     """The orthographic top view sees an object's outline at its true size wherever it stands:
     tipping changes its area or its shape; the robot can only hide part of it."""
@@ -540,7 +609,8 @@ ImageCheck = Callable[..., tuple[bool, str]]  # (observation, *objects) -> (hold
 IMAGE_CHECKS: Registry[ImageCheck] = Registry("image check")
 _checks: dict[str, ImageCheck] = {
     "on": _on, "inside": _inside, "released": _released, "pressed": _pressed, "upright": _upright,
-    "on_table": _on_table, "near": _near, "lifted": _lifted, "stacked": _stacked,
+    "on_table": _on_table, "near": _near, "lifted": _lifted, "stacked": _stacked, "opened": _opened,
+    "closed": _closed,
     "left_of": lambda obs, a, b: _side(obs, a, b, True),
     "right_of": lambda obs, a, b: _side(obs, a, b, False),
 }

@@ -81,6 +81,21 @@ def spread(mask: np.ndarray) -> np.ndarray:
     return np.sqrt(np.maximum(np.linalg.eigvalsh(np.cov(np.stack([rows, cols]).astype(float))), 0.0))
 
 
+def rectangle_sides(mask: np.ndarray, step_deg: float = 1.0) -> tuple[float, float]:
+    """Side lengths (pixels, longer first) of the smallest-area rectangle around ``mask``'s pixels,
+    over headings ``step_deg`` apart (0, 0 for an empty mask)."""
+    rows, cols = np.nonzero(mask)
+    if not len(rows):
+        return 0.0, 0.0
+    pts = np.column_stack([cols, rows]).astype(float)
+    angles = np.radians(np.arange(0.0, 90.0, step_deg))
+    u = pts @ np.stack([np.cos(angles), np.sin(angles)])  # (n, angles) along each heading
+    v = pts @ np.stack([-np.sin(angles), np.cos(angles)])  # and across it
+    a, b = np.ptp(u, axis=0) + 1, np.ptp(v, axis=0) + 1  # a pixel is 1 wide
+    k = int(np.argmin(a * b))
+    return float(max(a[k], b[k])), float(min(a[k], b[k]))
+
+
 def centroid_in(mask: np.ndarray, region: np.ndarray, tol: int) -> bool:
     """The centre of ``mask``'s pixels lies in ``region``'s hull grown by ``tol`` pixels."""
     rows, cols = np.nonzero(mask)

@@ -34,6 +34,11 @@ from vcage.synthesis.scene_file import PlacedObject, SynthesisRequest, Synthesiz
 WORK_AREA = Region((0.575, 0.0), (0.125, 0.3))
 TARGET_ZONE = 0.05  # half size of the zone kept free around a position target
 GRASPING_SKILLS = ("pick_and_place", "grasp")  # plan skills whose ``obj`` the fingers close on
+DRAWER_SKILLS = ("open_drawer", "close_drawer")  # plan skills that slide ``obj``'s drawer
+# An object whose drawer a plan slides turns its handle towards the robot, within this many radians,
+# and stands far enough back in the work area that its drawer, pulled out, stays in it (clear of the
+# arm's home pose in the top view, where the critic measures how far it is out)
+DRAWER_YAW = 0.35
 
 
 def plan_layout(plan: Plan, rng: np.random.Generator, rand: Randomization, clutter: int = 0,
@@ -47,6 +52,7 @@ def plan_layout(plan: Plan, rng: np.random.Generator, rand: Randomization, clutt
         looks[o.name] = (o.scale if o.scale is not None else scale, color, friction)
     grasped = {str(st.args["obj"]) for st in plan.subtasks if st.skill in GRASPING_SKILLS}
     receives = _room_needed(plan, {name: look[0] for name, look in looks.items()})
+    slides = _drawers_slid(plan, {name: look[0] for name, look in looks.items()})
     objects = []
     for o in _largest_first(plan):
         scale, color, friction = looks[o.name]
@@ -55,10 +61,12 @@ def plan_layout(plan: Plan, rng: np.random.Generator, rand: Randomization, clutt
         placed = scene.object(o.name) if scene is not None and not o.on else None
         if placed is not None:
             region, yaw = _nominal(placed, rand)
+        elif o.name in slides and not o.on:
+            region, yaw = _drawer_pose(o.type, scale, slides[o.name], work_area)
         room, room_at = receives.get(o.name, (0.0, None))
         objects.append(LayoutObject(o.name, o.type, support=support, region=region, yaw=yaw, scale=scale,
                                     color=color, friction=friction, grasped=o.name in grasped,
-                                    receives=room, receives_at=room_at))
+                                    receives=room, receives_at=room_at, slides=slides.get(o.name, 0.0)))
     relations = tuple(Relation(r.kind, r.a, r.b, r.distance) for r in plan.relations)
     reserved = tuple(
         ReservedZone(f"subtask{i}", Region((float(st.args["xy"][0]), float(st.args["xy"][1])),
@@ -97,6 +105,37 @@ def _room_needed(plan: Plan, scales: dict[str, float]) -> dict[str, tuple[float,
         if room > out.get(str(target), (0.0, None))[0]:
             out[str(target)] = (room, st.args.get("placement"))
     return out
+
+
+def _drawers_slid(plan: Plan, scales: dict[str, float]) -> dict[str, float]:
+    """How far each object whose drawer a subtask slides will have it out at most (metres)."""
+    types = {o.name: o.type for o in plan.objects}
+    out: dict[str, float] = {}
+    for st in plan.subtasks:
+        if st.skill not in DRAWER_SKILLS:
+            continue
+        name = str(st.args["obj"])
+        handle = next((p for p in CATALOG.get(types[name]).functional_points if p.kind == "handle"), None)
+        far = handle.stroke * scales[name] if handle is not None else 0.0
+        if st.args.get("distance") is not None:
+            far = float(st.args["distance"])
+        out[name] = max(out.get(name, 0.0), far)
+    return out
+
+
+def _drawer_pose(type_: str, scale: float, out: float,
+                 work_area: Region) -> tuple[Region, tuple[float, float]]:
+    """The region and yaw range of an object whose drawer comes ``out`` metres towards the robot
+    (-x): its handle faces the robot, and the drawer's front stays in ``work_area``."""
+    otype = CATALOG.get(type_)
+    handle = next(p for p in otype.functional_points if p.kind == "handle")
+    way_out = math.atan2(handle.direction[1], handle.direction[0])  # in the object's frame
+    facing = math.pi - way_out  # the yaw that turns the way out towards -x
+    half_depth = otype.size[0 if abs(math.cos(way_out)) > 0.5 else 1] * scale / 2
+    (x0, y0, x1, y1) = work_area.bounds
+    lo = min(x0 + half_depth + out, x1)
+    region = Region(((lo + x1) / 2, (y0 + y1) / 2), ((x1 - lo) / 2, (y1 - y0) / 2))
+    return region, (facing - DRAWER_YAW, facing + DRAWER_YAW)
 
 
 def _nominal(placed: PlacedObject, rand: Randomization) -> tuple[Region, tuple[float, float]]:

@@ -59,6 +59,16 @@ def press(obj: str, text: str, point: str | None = None) -> Subtask:
                                Predicate(name="upright", args=(obj,))))
 
 
+def open_drawer(obj: str, text: str) -> Subtask:
+    return Subtask(skill="open_drawer", args={"obj": obj}, description=text,
+                   predicates=(Predicate(name="opened", args=(obj,)),))
+
+
+def close_drawer(obj: str, text: str) -> Subtask:
+    return Subtask(skill="close_drawer", args={"obj": obj}, description=text,
+                   predicates=(Predicate(name="closed", args=(obj,)),))
+
+
 def put_at(obj: str, xy: tuple[float, float], text: str, left_of: str | None = None) -> Subtask:
     preds = [Predicate(name="on_table", args=(obj,)), Predicate(name="released", args=(obj,))]
     if left_of is not None:
@@ -237,6 +247,22 @@ GOALS: tuple[Goal, ...] = (
          (put_on("fan", "pad", "the fan stands on the pad", also=(holds("upright", "fan"),)),
           press("switch", "the fan's switch is flipped on", point="on"),
           put_on("cup", "coaster", "a cold drink stands on the coaster"))),
+    Goal("stow_the_soap",
+         ("stow the soap", "tuck the soap away", "keep the soap out of sight", "store the soap"),
+         (_obj("soap", "soap"), _obj("cabinet", "cabinet")),
+         (open_drawer("cabinet", "the cabinet's drawer is pulled open"),
+          # each depends on the one before: the soap goes into the open drawer, which is then shut (the
+          # soap, hidden in it then, is not checked again: no view shows it)
+          put_in("soap", "cabinet", "the soap lies in the open drawer"),
+          close_drawer("cabinet", "the drawer is shut with the soap inside"))),
+    Goal("clear_the_washstand",
+         ("clear the washstand", "tidy the washstand", "clean up the sink area", "tidy up after washing"),
+         (_obj("sponge", "sponge"), _obj("cabinet", "cabinet"), _obj("cup", "cup"),
+          _obj("coaster", "coaster")),
+         (put_on("cup", "coaster", "the cup stands on the coaster"),
+          open_drawer("cabinet", "the cabinet's drawer is pulled open"),
+          put_in("sponge", "cabinet", "the sponge lies in the open drawer"),
+          close_drawer("cabinet", "the drawer is shut with the sponge inside"))),
     Goal("block_city",
          ("block city", "lay out a block city", "play block city", "set out a little block city"),
          (_obj("red", "block", "red"), _obj("green", "block", "green"), _obj("blue", "block", "blue"),

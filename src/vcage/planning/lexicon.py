@@ -38,7 +38,7 @@ ALIASES = {
     "deck of cards": "card_deck", "pill": "pill_bottle", "medicine bottle": "pill_bottle",
     "french fries": "fries", "hamburger": "burger", "sneaker": "shoe", "trash can": "dustbin",
     "trash bin": "dustbin", "bin": "dustbin", "scale": "kitchen_scale", "mug rack": "mug_rack",
-    "rack": "mug_rack", "desk fan": "fan",
+    "rack": "mug_rack", "desk fan": "fan", "drawer": "cabinet",
 }
 # a name that may denote more than one type: a plan containing either covers it; in a step the
 # first is meant unless the context says otherwise (a phone's stand is the phone stand)

@@ -25,10 +25,12 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass, field
 
+from pydantic import ValidationError
+
 from vcage.assets.catalog import CATALOG
 from vcage.errors import ConfigError, PlanningError
 from vcage.planning.config import MAX_SUBTASKS
-from vcage.planning.goals import GOALS, Goal, press, put_in, put_on
+from vcage.planning.goals import GOALS, Goal, close_drawer, open_drawer, press, put_in, put_on
 from vcage.planning.language import Matcher, Scored, bounded, tokens
 from vcage.planning.lexicon import (
     ALIASES,
@@ -60,11 +62,14 @@ _PREFIX = re.compile(r"^(?:(?:please|kindly|now|first|firstly|next|finally|lastl
                      r"|i\s+(?:want|need|would\s+like|'?d\s+like)\s+you\s+to\s+)+")
 _PLACE_VERBS = "put|place|move|set|drop|lay|stack|nest|bring|carry"
 _PRESS_VERBS = "press|push|click|ring|hit|tap|silence|flip|toggle|turn on|turn off|switch on|switch off|use"
+_DRAWER_VERBS = "open|pull open|pull out|close|shut"
 _REL = r"on top of|onto|on|into|inside of|inside|in"
 _PLACE = re.compile(rf"^(?:{_PLACE_VERBS})\s+(?P<obj>.+?)\s+(?P<rel>{_REL})\s+(?P<target>.+)$")
 _ELIDED = re.compile(rf"^(?P<obj>.+?)\s+(?P<rel>{_REL})\s+(?P<target>.+)$")  # "..., the cup on the coaster"
 _PRESS = re.compile(rf"^(?P<verb>{_PRESS_VERBS})\s+(?P<obj>.+)$")
-_COMMAND = re.compile(rf"^(?:{_PLACE_VERBS}|{_PRESS_VERBS}|switch|turn)\b")
+# "close up the office" and "shut down the laptop" are not about a drawer
+_DRAWER = re.compile(rf"^(?P<verb>{_DRAWER_VERBS})\s+(?!(?:up|down|off)\b)(?P<obj>.+)$")
+_COMMAND = re.compile(rf"^(?:{_PLACE_VERBS}|{_PRESS_VERBS}|{_DRAWER_VERBS}|switch|turn)\b")
 _GERUNDS = {"putting": "put", "placing": "place", "moving": "move", "setting": "set", "dropping": "drop",
             "laying": "lay", "stacking": "stack", "nesting": "nest", "pressing": "press", "pushing": "push",
             "ringing": "ring", "hitting": "hit", "tapping": "tap", "silencing": "silence", "flipping": "flip"}
@@ -105,6 +110,10 @@ class _Objects:
 
     def objects(self) -> tuple[PlanObject, ...]:
         return tuple(o for _, o in self.items)
+
+
+def _has_drawer(type_: str) -> bool:
+    return any(p.kind == "handle" and p.joint for p in CATALOG.get(type_).functional_points)
 
 
 def _words(o: PlanObject) -> str:
@@ -169,7 +178,8 @@ def _elided(piece: str, previous: str) -> str:
 
 def _is_step(clause: str) -> bool:
     """Whether ``clause`` is (or tries to be) an explicit step: a step's shape, or a command verb
-    and a catalog object."""
+    (opening or closing a drawer among them: "shut everything down" is not a step) and a catalog
+    object."""
     if _PLACE.match(clause) or _PRESS.match(clause):
         return True
     return bool(_COMMAND.match(clause) and find_mentions(words(clause)))
@@ -241,7 +251,11 @@ class OfflinePlanner:
                 raise PlanningError(f"{exc}{self._understood(clauses, subtasks)}") from None
         if not subtasks:
             raise PlanningError(f"no step in {bounded(text)}; {self.capabilities()}")
-        plan = Plan(instruction=text, objects=objects.objects(), subtasks=tuple(subtasks))
+        try:
+            plan = Plan(instruction=text, objects=objects.objects(), subtasks=tuple(subtasks))
+        except ValidationError as exc:  # steps that cannot follow each other (into a shut drawer)
+            problems = "; ".join(str(e["msg"]).removeprefix("Value error, ") for e in exc.errors())
+            raise PlanningError(f"cannot ground {bounded(text)}: {problems}") from None
         missing = self._missing(" ; ".join(clauses), plan.objects)
         if missing:  # a parse that lost an object would label the episode wrongly
             raise PlanningError(f"cannot ground {bounded(text)}: the steps read as {self._steps(subtasks)} "
@@ -269,12 +283,28 @@ class OfflinePlanner:
             kind = places[0].kind
             text = f"the {_words(o)} is {'in' if kind == 'in' else 'on'} the {_words(t)}"
             return (put_in if kind == "in" else put_on)(o.name, t.name, text)
+        m = _DRAWER.match(clause)
+        if m:
+            ref = parse_phrase(m["obj"], clause)
+            _check_colour(ref, ref.type)
+            o = objects.resolve(ref, ref.type, clause)
+            if not _has_drawer(o.type):
+                with_drawers = [x.name for x in CATALOG.values() if _has_drawer(x.name)]
+                raise PlanningError(f"a {o.type.replace('_', ' ')} has no drawer to open or close (in "
+                                    f"{bounded(clause)}); objects with a drawer: {', '.join(with_drawers)}")
+            if m["verb"] in ("close", "shut"):
+                return close_drawer(o.name, f"the {_words(o)}'s drawer is shut")
+            return open_drawer(o.name, f"the {_words(o)}'s drawer is pulled open")
         m = _PRESS.match(clause)
         if m:
             ref = parse_phrase(m["obj"], clause)
             _check_colour(ref, ref.type)
             o = objects.resolve(ref, ref.type, clause)
             fps = CATALOG.get(o.type).functional_points
+            if _has_drawer(o.type):
+                raise PlanningError(f"a {o.type.replace('_', ' ')}'s handle opens or closes its drawer, it "
+                                    f"is not pressed (in {bounded(clause)}); say 'open the {_words(o)}' or "
+                                    f"'close the {_words(o)}'")
             if not fps or fps[0].joint is None:
                 raise PlanningError(f"a {o.type.replace('_', ' ')} cannot be pressed (in {bounded(clause)}); "
                                     f"pressable: {', '.join(x.name for x in CATALOG.by_tag('pressable'))}")
@@ -286,8 +316,8 @@ class OfflinePlanner:
                                         "'flip the switch'")
                 point = fps[0].name
             return press(o.name, f"the {_words(o)} is pressed", point=point)
-        raise PlanningError(f"cannot read {bounded(clause)} as a step: a step is 'put/place/move X on/in Y' "
-                            f"or 'press/ring/flip Z', naming catalog objects")
+        raise PlanningError(f"cannot read {bounded(clause)} as a step: a step is 'put/place/move X on/in Y', "
+                            f"'press/ring/flip Z' or 'open/close the drawer', naming catalog objects")
 
     def _understood(self, clauses: list[str], subtasks: list[Subtask]) -> str:
         seen = listed(list(dict.fromkeys(m.label() for m in find_mentions(words(" ; ".join(clauses))))))

@@ -138,7 +138,26 @@ class Plan(_Strict):
             if unknown:
                 raise ValueError(f"subtask {i} ({st.skill}) names unknown object(s) {unknown}; "
                                  f"plan objects: {names}")
+        self._drawers_open_when_used()
         return self
+
+    def _drawers_open_when_used(self) -> None:
+        """Something put into a drawer goes in while that drawer is open: every drawer starts shut, an
+        ``open_drawer`` subtask opens it, ``close_drawer`` shuts it."""
+        types = {o.name: o.type for o in self.objects}
+        opened: set[str] = set()
+        for i, st in enumerate(self.subtasks):
+            target = st.args.get("target")
+            if st.skill == "open_drawer":
+                opened.add(str(st.args["obj"]))
+            elif st.skill == "close_drawer":
+                opened.discard(str(st.args["obj"]))
+            elif st.skill == "pick_and_place" and isinstance(target, str) and target in types \
+                    and target not in opened \
+                    and CATALOG.get(types[target]).placement(st.args.get("placement")).joint is not None:
+                raise ValueError(f"subtask {i} puts {st.args['obj']!r} into the drawer of {target!r} "
+                                 f"while it is shut; open it first (an open_drawer subtask of {target!r} "
+                                 "before it)")
 
     def object(self, name: str) -> PlanObject:
         return next(o for o in self.objects if o.name == name)

@@ -70,7 +70,9 @@ class LayoutObject:
     sweep free (its finger zones); objects that are only targets or pressed need none.
     ``receives`` is the radius kept free around the centre of the placement region ``receives_at``
     (None: the first) of an object the robot will put something on or in: what the hand carries
-    there, fingers included.
+    there, fingers included. ``slides`` is how far the object's drawer will come out: the ground
+    in front of it, as wide as the object, and the hand's room at the handle at that opening, are
+    kept free.
     """
 
     name: str
@@ -85,6 +87,7 @@ class LayoutObject:
     grasped: bool = True
     receives: float = 0.0
     receives_at: str | None = None
+    slides: float = 0.0
 
     def __post_init__(self) -> None:
         if self.yaw[0] > self.yaw[1]:

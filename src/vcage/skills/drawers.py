@@ -43,11 +43,17 @@ def opening(world: World, obj: str, point: str | None = None) -> float:
     return -world.joint_value(f"{obj}/{handle_of(world, obj, point).joint}")
 
 
+def slid(world: World, obj: str, joint: str | None) -> np.ndarray:
+    """Where what rides on ``obj``'s slide joint ``joint`` (along the object's x axis) is now,
+    relative to where it is at the joint's zero (object frame, metres); zero without a joint."""
+    return np.array([world.joint_value(f"{obj}/{joint}") if joint else 0.0, 0.0, 0.0])
+
+
 def handle_pos(world: World, obj: str, point: str | None = None) -> np.ndarray:
     """World position of ``obj``'s drawer handle now (it moves with the drawer)."""
     inst = world.object(obj)
     fp = handle_of(world, obj, point)
-    local = np.asarray(fp.pos, float) * inst.scale + [world.joint_value(f"{obj}/{fp.joint}"), 0.0, 0.0]
+    local = np.asarray(fp.pos, float) * inst.scale + slid(world, obj, fp.joint)
     return world.object_pos(obj) + world.object_mat(obj) @ local
 
 

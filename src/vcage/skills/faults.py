@@ -2,11 +2,12 @@
 
 A critic exists to catch failures that raise nothing: a release too high or too late, a place off
 target or on an edge, the wrong object moved, a press too light or beside the button, a neighbour
-knocked over, a turn short of its angle, a stroke that stops short, a shake too weak. Each fault
-here is a named, seeded perturbation of one skill call, registered in ``FAULTS``; a
-:class:`FaultInjector` built from a frozen :class:`FaultConfig` is given to
-:class:`~vcage.skills.base.Skills` (``Skills(world, fault=FaultInjector(cfg))``) and replaces the
-plan of the chosen call (or, for faults that act on the result, adds to the next call's plan).
+knocked over, a turn short of its angle, a stroke that stops short, a shake too weak, a drawer
+slid only part of the way. Each fault here is a named, seeded perturbation of one skill call,
+registered in ``FAULTS``; a :class:`FaultInjector` built from a frozen :class:`FaultConfig` is
+given to :class:`~vcage.skills.base.Skills` (``Skills(world, fault=FaultInjector(cfg))``) and
+replaces the plan of the chosen call (or, for faults that act on the result, adds to the next
+call's plan).
 
 A fault changes what the robot does, never the simulator's state directly: the failure happens in
 MuJoCo like any other rollout, and whether the goal was missed is for the oracle to say afterwards
@@ -37,6 +38,7 @@ from vcage.skills.base import (
     TCP_MIN_ABOVE_TABLE,
     Skills,
 )
+from vcage.skills.drawers import PAST_SHUT, handle_of, opening, slide
 from vcage.skills.motion import MotionPlan, Waypoint
 from vcage.skills.primitives import lift, move_line, placement_target, press, push, shake, turn_and_place
 
@@ -319,6 +321,19 @@ def _stop_short(s: Skills, skill: str, args: Args, rng: np.random.Generator) -> 
     start, _ = s.tcp()
     goal = np.asarray(args["pos"], float)
     return move_line(s, **{**args, "pos": start + rng.uniform(0.4, 0.7) * (goal - start)})
+
+
+@_fault("pull_short", ("open_drawer", "close_drawer"), "slide the drawer only 30-60% of the way asked")
+def _pull_short(s: Skills, skill: str, args: Args, rng: np.random.Generator) -> MotionPlan:
+    obj, point = str(args["obj"]), args.get("point")
+    now = opening(s.world, obj, point)
+    if skill == "close_drawer":
+        to = -PAST_SHUT
+    elif args.get("distance") is not None:
+        to = float(args["distance"])
+    else:
+        to = handle_of(s.world, obj, point).stroke * s.world.object(obj).scale
+    return slide(s, obj, now + rng.uniform(0.3, 0.6) * (to - now), point, skill)
 
 
 @_fault("shake_weak", ("shake",), "shake once, at 20-40% of the amplitude asked")

@@ -25,6 +25,7 @@ from vcage.skills.base import (
     TCP_MIN_ABOVE_TABLE,
     Skills,
 )
+from vcage.skills.drawers import slid
 from vcage.skills.ik import down_rotation
 from vcage.skills.motion import MotionPlan, Waypoint
 
@@ -86,12 +87,14 @@ def _held_offset(s: Skills, obj: str) -> np.ndarray:
 
 
 def placement_target(s: Skills, target: str, placement: str | None = None) -> tuple[np.ndarray, float]:
-    """World position (surface height) and yaw of ``target``'s placement annotation."""
+    """World position (surface height) and yaw of ``target``'s placement annotation (where it is
+    now: a drawer's inside comes out with the drawer)."""
     inst = s.world.object(target)
     otype = CATALOG.get(inst.type_name)
     place = otype.placement(placement)
     pos, rot = s.world.object_pos(target), s.world.object_mat(target)
-    return pos + rot @ (np.asarray(place.pos) * inst.scale), yaw_of(rot)
+    local = np.asarray(place.pos) * inst.scale + slid(s.world, target, place.joint)
+    return pos + rot @ local, yaw_of(rot)
 
 
 @SKILLS.register("place")

@@ -16,19 +16,23 @@ from vcage.geometry import tilt_of
 from vcage.registry import Registry
 from vcage.scene.spec import ROBOT_MOUNT
 from vcage.sim.world import World
+from vcage.skills.drawers import slid
 
 XY_TOL = 0.01  # slack beyond a placement region's edge
 Z_TOL = 0.02  # how far above a surface an object may rest and still be "on" it
 SURFACE_TILT = np.pi / 4  # radians a placement surface may tilt and still hold what rests on it
+SHUT_TOL = 0.01  # metres a drawer may stand out and still count as shut
 
 
 def _region(world: World, target: str,
             placement: str | None) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
-    """Centre (world), rotation, half size and wall height of ``target``'s placement region."""
+    """Centre (world), rotation, half size and wall height of ``target``'s placement region, where
+    it is now (a drawer's inside comes out with the drawer)."""
     inst = world.object(target)
     place = CATALOG.get(inst.type_name).placement(placement)
     rot = world.object_mat(target)
-    center = world.object_pos(target) + rot @ (np.asarray(place.pos) * inst.scale)
+    local = np.asarray(place.pos) * inst.scale + slid(world, target, place.joint)
+    center = world.object_pos(target) + rot @ local
     return center, rot, np.asarray(place.half_size) * inst.scale, place.wall_height * inst.scale
 
 
@@ -145,6 +149,26 @@ def pressed(world: World, obj: str, point: str | None = None) -> bool:
     return joint_displacement(world, obj, fp.joint) >= travel
 
 
+def _drawer_out(world: World, obj: str, point: str | None) -> tuple[float, float] | None:
+    """How far ``obj``'s drawer is out and how far counts as open; None if it has no drawer."""
+    fp = CATALOG.get(world.object(obj).type_name).functional_point(point)
+    if fp.kind != "handle" or fp.joint is None:
+        return None
+    return joint_displacement(world, obj, fp.joint), fp.travel
+
+
+def opened(world: World, obj: str, point: str | None = None) -> bool:
+    """``obj``'s drawer is out by at least its handle's annotated travel."""
+    out = _drawer_out(world, obj, point)
+    return out is not None and out[0] >= out[1]
+
+
+def closed(world: World, obj: str, point: str | None = None, tol: float = SHUT_TOL) -> bool:
+    """``obj``'s drawer is within ``tol`` of shut."""
+    out = _drawer_out(world, obj, point)
+    return out is not None and out[0] <= tol
+
+
 def moved(world: World, obj: str, start_xy: np.ndarray, distance: float) -> bool:
     return bool(np.linalg.norm(world.object_pos(obj)[:2] - np.asarray(start_xy)[:2]) >= distance)
 
@@ -176,3 +200,5 @@ ORACLE_CHECKS.add("upright", lambda w, a: upright(w, a))
 ORACLE_CHECKS.add("lifted", lambda w, a: lifted(w, a))
 ORACLE_CHECKS.add("released", lambda w, a: not grasped(w, a))
 ORACLE_CHECKS.add("pressed", lambda w, a: pressed(w, a))  # an event: the oracle latches it
+ORACLE_CHECKS.add("opened", lambda w, a: opened(w, a))
+ORACLE_CHECKS.add("closed", lambda w, a: closed(w, a))

@@ -206,9 +206,9 @@ CATALOG.add_type(ObjectType(
     build=_cabinet, tags=frozenset({"container", "pressable", "articulated", "furniture"}),
     scale_range=(1.0, 1.0),
     annotations=Annotations(
-        # the drawer's inside while it is shut
+        # the drawer's inside (where it is while the drawer is shut; it comes out with the drawer)
         placements=(Placement("inside", "in", (round(DRAWER_CX, 4), 0, DRAWER_FLOOR), DRAWER_INNER,
-                              DRAWER_WALL),),
+                              DRAWER_WALL, joint="drawer"),),
         functional_points=(FunctionalPoint("handle", "handle", (round(_HANDLE_X, 4), 0, HANDLE_Z),
                                            joint="drawer", travel=DRAWER_TRAVEL, stroke=DRAWER_PULL,
                                            direction=(-1.0, 0.0, 0.0)),),

@@ -29,6 +29,7 @@ from vcage.scene.layout import LayoutObject, LayoutSpec
 from vcage.scene.placement.base import PLACERS, PlacementStats, Placer, Pose, height, support_frame
 from vcage.scene.placement.free_space import Occupant, SurfaceMap
 from vcage.scene.placement.geometry import (
+    drawer_zone,
     erode_box,
     footprint,
     grasp_zone,
@@ -198,7 +199,8 @@ class ContextAwarePlacer(Placer):
 
     def _zone(self, obj: LayoutObject, yaw: float, xy: tuple[float, float]) -> tuple[Polygon, ...]:
         """The ground the hand needs around a task object on the table: its finger zones if the
-        robot grasps it, the room of what it carries there if it receives something."""
+        robot grasps it, the room of what it carries there if it receives something, and where its
+        drawer comes out if the robot opens it."""
         if not (self.config.finger_zones and obj.task and obj.support.is_table):
             return ()
         slack = self.config.finger_slack
@@ -207,6 +209,8 @@ class ContextAwarePlacer(Placer):
             place = CATALOG.get(obj.type).placement(obj.receives_at)
             center = to_world(xy, yaw, (place.pos[0] * obj.scale, place.pos[1] * obj.scale))
             pieces += (Point(center).buffer(obj.receives + slack, 16),)
+        if obj.slides > 0:
+            pieces += (drawer_zone(obj.type, obj.scale, yaw, obj.slides, xy, slack),)
         return pieces
 
     def _commit(self, obj: LayoutObject, pose: Pose) -> None:

@@ -44,6 +44,24 @@ def grasp_zone(type_name: str, scale: float, yaw: float, xy: tuple[float, float]
     return tuple(boxes)
 
 
+def drawer_zone(type_name: str, scale: float, yaw: float, out: float, xy: tuple[float, float] = (0.0, 0.0),
+                slack: float = 0.0) -> Polygon:
+    """The ground a drawer of ``type_name`` sweeps when it comes ``out`` metres out along its
+    handle's direction, as wide as the object, and the hand's reach beyond the handle there (the
+    fingers close along the slide), grown by ``slack``. Empty without a drawer handle."""
+    otype = CATALOG.get(type_name)
+    handle = next((p for p in otype.functional_points if p.kind == "handle" and p.joint), None)
+    if handle is None or out <= 0:
+        return EMPTY
+    sx, sy = (s * scale / 2 for s in otype.size[:2])
+    direction = math.atan2(handle.direction[1], handle.direction[0])  # in the object's frame
+    depth = out + FINGER_OUTER + slack  # beyond the footprint's edge on the handle's side
+    edge = abs(sx * math.cos(direction)) + abs(sy * math.sin(direction))
+    across = abs(sx * math.sin(direction)) + abs(sy * math.cos(direction))
+    center = to_world(xy, yaw + direction, (edge + depth / 2, 0.0))
+    return rotated_rect(center, yaw + direction, (depth / 2, across + slack))
+
+
 def carry_radius(type_name: str, scale: float) -> float:
     """How far from its origin ``type_name`` held in the hand reaches, closed fingers included, for
     the widest of its grasps: the room it needs where it is put down."""

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 from typing import Any
 
-from vcage.assets.objects.tools import DRAWER_TRAVEL
 from vcage.sim.world import World
 from vcage.skills.base import Skills
 from vcage.tasks import predicates as P
@@ -24,7 +23,7 @@ class OpenDrawer(AtomicTask):
         skills.do("retreat")
 
     def evaluate(self, world: World) -> dict[str, Any]:
-        opened = P.joint_displacement(world, "cabinet", "drawer") >= DRAWER_TRAVEL
+        opened = P.opened(world, "cabinet")
         standing = P.upright(world, "cabinet") and P.on_table(world, "cabinet")
         released = not P.grasped(world, "cabinet")
         return {"success": opened and standing and released, "opened": opened, "standing": standing,

@@ -17,7 +17,6 @@ from vcage.tasks.library._support import local_xy, turn_to_align
 
 OBJECTS = ("sponge", "soap")  # low enough to pass under the cabinet's top
 OPENING = 0.13
-SHUT_TOL = 0.01  # the drawer counts as shut within this of its closed stop
 
 
 @TASKS.register("put_object_cabinet")
@@ -50,7 +49,7 @@ class PutObjectCabinet(AtomicTask):
 
     def evaluate(self, world: World) -> dict[str, Any]:
         inside = P.inside(world, "object", "cabinet")
-        shut = P.joint_displacement(world, "cabinet", "drawer") <= SHUT_TOL
+        shut = P.closed(world, "cabinet")
         released = not P.grasped(world, "object")
         return {"success": inside and shut and released, "inside": inside, "shut": shut,
                 "released": released}
