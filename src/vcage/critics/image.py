@@ -14,7 +14,9 @@ simulator state. Each predicate is checked in image space:
   top view's depth, ``a`` is down on ``b``: its lowest point is no higher than its type's height
   above ``b``'s surface (for ``inside``, its rim), and it does not lie over another object that
   stood higher than that surface before the subtask (clutter on the target); an object that stood on
-  its base with a curved top before and shows a flat one now lies turned over.
+  its base with a curved top before and shows a flat one now lies turned over. In a drawer (a
+  placement that comes out with a joint) ``a`` also lies over what came out of ``b``, not on its
+  body, and lower than the drawer's rim.
 - ``released(a)``: after the retreat, the robot does not touch ``a`` in every view that shows it
   (a projection overlap in one view is not contact); ``a`` hidden in every view is not released.
 - ``pressed(x)``: in the views at the subtask's deepest moment the robot touches ``x`` (front view,
@@ -55,7 +57,8 @@ from collections.abc import Callable
 
 import numpy as np
 
-from vcage.assets.catalog import CATALOG
+from vcage.assets.annotations import Placement
+from vcage.assets.catalog import CATALOG, ObjectType
 from vcage.critics.base import CRITICS, Critic, CriticConfig, Observation, Verdict, View
 from vcage.critics.masks import (
     TOUCH,
@@ -123,6 +126,13 @@ NEARER = 0.005
 # the estimate's excess (0.2-0.9 cm on renders of the cabinet 0-14 cm out at four headings, where
 # nothing hid it; a pixel is 3.7 mm)
 SHUT_OUT = 0.015
+# What lies in an open drawer: this share of its top-view pixels over what came out of the body (the
+# body's top: its pixels within TOP_BAND_BODY metres of its highest point; the drawer's front, 2 mm
+# below it, counts as body). On the drawer goals' balanced set what lay in the drawer had 0.99-1.00
+# of its pixels there and its lowest point 0.5-2 cm below the rim; what missed it, 0.00-0.77 or a
+# lowest point above the rim
+IN_DRAWER = 0.9
+TOP_BAND_BODY = 0.006
 
 
 class ImageCritic(Critic):
@@ -331,7 +341,12 @@ def _on(obs: Observation, a: str, b: str) -> tuple[bool, str]:
 
 
 def _inside(obs: Observation, a: str, b: str) -> tuple[bool, str]:
-    return _rests_on(obs, a, b, inside=True)
+    ok, why = _rests_on(obs, a, b, inside=True)
+    otype = CATALOG.get(obs.types[b]) if obs.types.get(b) in CATALOG else None
+    drawer = next((p for p in otype.placements if p.kind == "in" and p.joint), None) if otype else None
+    if not ok or drawer is None:
+        return ok, why
+    return _in_drawer(obs, a, b, drawer)
 
 
 def _released(obs: Observation, a: str) -> tuple[bool, str]:
@@ -481,10 +496,41 @@ def _drawer(obs: Observation, x: str) -> tuple[float, float, bool] | str:
     heights, mask = _heights(after), _mask(obs, after, x)
     if heights is None or after.pixel_size is None or mask.sum() < MIN_RELIEF_PX:
         return f"{x} is not seen in the top view's heights"
-    scale = float(heights[_inner(mask)].max()) / otype.size[2]
+    scale = _scale(otype, heights, mask)
     long, short = rectangle_sides(mask)
     out = (long + short) * after.pixel_size - (otype.size[0] + otype.size[1]) * scale
     return out, point.travel * scale, _hidden(after, mask) > 0
+
+
+def _scale(otype: ObjectType, heights: np.ndarray, mask: np.ndarray) -> float:
+    """An object's scale from its top (the 95th percentile of its inner heights: a stray pixel's depth
+    can be far off) over its type's height, within the type's scale range."""
+    top = float(np.percentile(heights[_inner(mask)], 95))
+    return float(np.clip(top / otype.size[2], *otype.scale_range))
+
+
+def _in_drawer(obs: Observation, a: str, b: str, place: Placement) -> tuple[bool, str]:
+    """``a`` lies in ``b``'s open drawer (``place``, the placement that comes out with it), by the top
+    view's heights: over what came out of ``b`` (its pixels before the subtask below the top of its
+    body), not on its body, and lower than the drawer's rim."""
+    before, after = obs.before.get(TOP), obs.after.get(TOP)
+    hb = _heights(before) if before is not None else None
+    ha = _heights(after) if after is not None else None
+    otype = CATALOG.get(obs.types[b])
+    if before is None or after is None or hb is None or ha is None:
+        return False, "the top view's heights before and after are needed"
+    mb, ma = _mask(obs, before, b), _mask(obs, after, a)
+    if not mb.any() or not ma.any():
+        return False, f"{a} or {b} is not seen from the top"
+    body = mb & (hb >= float(np.percentile(hb[_inner(mb)], 95)) - TOP_BAND_BODY)
+    share = float((ma & dilate(mb & ~body, 1)).sum() / ma.sum())
+    if share < IN_DRAWER:
+        return False, f"only {share:.0%} of {a} lies over {b}'s open drawer from the top"
+    rim = (place.pos[2] + place.wall_height) * _scale(otype, hb, mb)
+    low = float(ha[ma].min())
+    if low > rim:
+        return False, f"{a} lies {100 * (low - rim):.1f} cm higher than the rim of {b}'s drawer"
+    return True, f"{share:.0%} of {a} over {b}'s open drawer"
 
 
 def _opened(obs: Observation, x: str) -> tuple[bool, str]:
