@@ -67,8 +67,11 @@ SCENARIOS: dict[str, tuple[tuple[O, ...], Subtask]] = {
                                  ("right_of", ("a", "b")), ("released", ("a",)))),
     "opened": (CABINET, open_drawer("cab", "the drawer is open")),
     "closed": (CABINET, close_drawer("cab", "the drawer is shut")),  # after opening it (BEFORE)
+    "inside_drawer": ((*CABINET, O("soap", "soap", (0.5, -0.15))),
+                      put_in("soap", "cab", "the soap is in the open drawer")),  # after opening it
 }
-BEFORE = {"closed": (open_drawer("cab", "the drawer is open"),)}
+BEFORE = {"closed": (open_drawer("cab", "the drawer is open"),),
+          "inside_drawer": (open_drawer("cab", "the drawer is open"),)}
 
 # (scenario, fault, seed, the predicate that must fail in the oracle and in the critic's checks)
 FAILURES = [
@@ -96,6 +99,8 @@ FAILURES = [
     ("right_of", "wrong_object", 0, "right_of(a, b)"),
     ("opened", "pull_short", 1, "opened(cab)"),
     ("closed", "pull_short", 2, "closed(cab)"),
+    # over the cabinet's hull, as resting in it would be, but mostly on its body beside the drawer
+    ("inside_drawer", "release_late", 1, "inside(soap, cab)"),
 ]
 
 
@@ -224,3 +229,19 @@ def test_a_lone_pixel_at_the_outline_does_not_set_how_high_the_button_is() -> No
     verdict = CRITIC.judge(spoiled)
     assert not verdict.accept
     assert "short of pressing clock" in verdict.reason
+
+
+def test_a_stray_pixel_inside_a_cabinet_does_not_shrink_how_far_its_drawer_is_out() -> None:
+    """A drawer left half open, with one pixel inside the cabinet's outline reading 6 cm above its top
+    (a stray depth, as seen on rollouts): the cabinet's scale comes from its type's range, so the
+    drawer still measures as out, not as shut."""
+    result = _run("closed", "pull_short", 2)
+    obs = result.obs
+    view = obs.after["top"]
+    cab = view.segmentation == obs.labels.index("cab")
+    inner = cab & ~np.roll(~cab, 1, axis=0) & ~np.roll(~cab, -1, axis=0)
+    rows, cols = np.nonzero(inner)
+    depth = view.depth.copy()
+    depth[rows[len(rows) // 2], cols[len(cols) // 2]] -= 0.06
+    verdict = CRITIC.judge(replace(obs, after={**obs.after, "top": replace(view, depth=depth)}))
+    assert not verdict.accept and "not shut" in verdict.reason, verdict.reason
