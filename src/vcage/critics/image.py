@@ -43,8 +43,8 @@ simulator state. Each predicate is checked in image space:
 - ``opened(x)`` / ``closed(x)``: how far ``x``'s drawer is out, from the top view after the
   subtask: the sides of the smallest rectangle around ``x``'s outline, together, less its type's
   footprint (the object shut; the drawer is narrower than the body, so only the side it slides along
-  grows); open from the handle's travel on, shut under :data:`SHUT_OUT`. Where the robot hides part
-  of ``x`` a drawer is not judged shut.
+  grows); open from the handle's travel and :data:`OPEN_MARGIN` on, shut under :data:`SHUT_OUT`.
+  Where the robot hides part of ``x`` a drawer is not judged shut.
 
 Every predicate of :mod:`vcage.vocabulary` has a check in ``IMAGE_CHECKS``. Without the top view's
 depth (or the object's type), a press that touches the button but moves it less than its travel (a
@@ -122,10 +122,14 @@ BUTTON_COVER = 0.8
 # Metres by which an object below the hand's lowest pixel in the front view must be nearer the camera
 # than the hand to hide where the hand goes down (a cup's rim 1.3 cm in front of the fingers was seen)
 NEARER = 0.005
-# How far out (metres) a drawer may look in the top view and count as shut: the oracle's 1 cm and
-# the estimate's excess (0.2-0.9 cm on renders of the cabinet 0-14 cm out at four headings, where
-# nothing hid it; a pixel is 3.7 mm)
-SHUT_OUT = 0.015
+# How far out (metres) a drawer may look in the top view and count as shut, and how much further
+# than the travel that counts as open it must look to count as open. The estimate exceeds the
+# opening by 0.2-0.9 cm (renders of the cabinet 0-14 cm out at four headings, nothing hiding it; a
+# pixel is 3.7 mm), so both err towards "no": shut drawers read 0.2-0.9 cm, the skill pulls to 12 cm.
+# On Vanilla rollouts (seeds 0-19 of the drawer goals) a drawer read 1.47 cm that the oracle found
+# more than 1 cm out, and 8.4 cm that it found short of 8
+SHUT_OUT = 0.012
+OPEN_MARGIN = 0.01
 # What lies in an open drawer: this share of its top-view pixels over what came out of the body (the
 # body's top: its pixels within TOP_BAND_BODY metres of its highest point; the drawer's front, 2 mm
 # below it, counts as body). On the drawer goals' balanced set what lay in the drawer had 0.99-1.00
@@ -133,6 +137,7 @@ SHUT_OUT = 0.015
 # lowest point above the rim
 IN_DRAWER = 0.9
 TOP_BAND_BODY = 0.006
+FLOOR_TOL = 0.005  # metres an object's top may lie below its least height above a drawer's floor
 
 
 class ImageCritic(Critic):
@@ -511,8 +516,10 @@ def _scale(otype: ObjectType, heights: np.ndarray, mask: np.ndarray) -> float:
 
 def _in_drawer(obs: Observation, a: str, b: str, place: Placement) -> tuple[bool, str]:
     """``a`` lies in ``b``'s open drawer (``place``, the placement that comes out with it), by the top
-    view's heights: over what came out of ``b`` (its pixels before the subtask below the top of its
-    body), not on its body, and lower than the drawer's rim."""
+    view's heights: the drawer is still open after the subtask; ``a`` lies over what came out of
+    ``b`` (its pixels before the subtask below the top of its body), not on its body; its lowest
+    point is below the drawer's rim, and its top is as high as resting on the drawer's floor makes it
+    at least (lower, it lies on the table in front of the drawer)."""
     before, after = obs.before.get(TOP), obs.after.get(TOP)
     hb = _heights(before) if before is not None else None
     ha = _heights(after) if after is not None else None
@@ -522,14 +529,27 @@ def _in_drawer(obs: Observation, a: str, b: str, place: Placement) -> tuple[bool
     mb, ma = _mask(obs, before, b), _mask(obs, after, a)
     if not mb.any() or not ma.any():
         return False, f"{a} or {b} is not seen from the top"
-    body = mb & (hb >= float(np.percentile(hb[_inner(mb)], 95)) - TOP_BAND_BODY)
+    drawer = _drawer(obs, b)
+    if isinstance(drawer, str) or drawer[0] < drawer[1]:
+        return False, f"{b}'s drawer is not open after the subtask, so {a} cannot be seen in it"
+    top = float(np.percentile(hb[_inner(mb)], 95))
+    body = mb & (hb >= top - TOP_BAND_BODY)
     share = float((ma & dilate(mb & ~body, 1)).sum() / ma.sum())
     if share < IN_DRAWER:
         return False, f"only {share:.0%} of {a} lies over {b}'s open drawer from the top"
-    rim = (place.pos[2] + place.wall_height) * _scale(otype, hb, mb)
+    scale = _scale(otype, hb, mb)
+    lift = max(0.0, top - otype.size[2] * scale)  # standing on something, not on the table
+    rim, floor = lift + (place.pos[2] + place.wall_height) * scale, lift + place.pos[2] * scale
     low = float(ha[ma].min())
     if low > rim:
         return False, f"{a} lies {100 * (low - rim):.1f} cm higher than the rim of {b}'s drawer"
+    atype = CATALOG.get(obs.types[a]) if obs.types.get(a) in CATALOG else None
+    if atype is not None:
+        a_top = float(np.percentile(ha[_inner(ma)], 95))
+        least = floor + atype.size[2] * atype.scale_range[0] - FLOOR_TOL
+        if a_top < least:
+            return False, (f"{a}'s top is {100 * (least - a_top):.1f} cm lower than lying on the floor of "
+                           f"{b}'s drawer makes it: {a} lies beside the drawer")
     return True, f"{share:.0%} of {a} over {b}'s open drawer"
 
 
@@ -538,10 +558,11 @@ def _opened(obs: Observation, x: str) -> tuple[bool, str]:
     if isinstance(drawer, str):
         return False, drawer
     out, travel, hidden = drawer
-    if out >= travel:
+    if out >= travel + OPEN_MARGIN:
         return True, "opened"
-    why = f"{x}'s drawer is out about {100 * out:.1f} cm in the top view, less than the {100 * travel:.0f} cm"
-    return False, why + " that count as open" + (" (the robot hides part of it)" if hidden else "")
+    why = (f"{x}'s drawer is out about {100 * out:.1f} cm in the top view, less than the "
+           f"{100 * (travel + OPEN_MARGIN):.0f} cm that count as open")
+    return False, why + (" (the robot hides part of it)" if hidden else "")
 
 
 def _closed(obs: Observation, x: str) -> tuple[bool, str]:
