@@ -16,7 +16,7 @@ from vcage.geometry import tilt_of
 from vcage.registry import Registry
 from vcage.scene.spec import ROBOT_MOUNT
 from vcage.sim.world import World
-from vcage.skills.drawers import slid
+from vcage.skills.drawers import opening, slid
 
 XY_TOL = 0.01  # slack beyond a placement region's edge
 Z_TOL = 0.02  # how far above a surface an object may rest and still be "on" it
@@ -150,11 +150,12 @@ def pressed(world: World, obj: str, point: str | None = None) -> bool:
 
 
 def _drawer_out(world: World, obj: str, point: str | None) -> tuple[float, float] | None:
-    """How far ``obj``'s drawer is out and how far counts as open; None if it has no drawer."""
+    """How far ``obj``'s drawer is out (signed: a drawer pushed past its stop is further in than
+    shut, not out) and how far counts as open; None if it has no drawer."""
     fp = CATALOG.get(world.object(obj).type_name).functional_point(point)
     if fp.kind != "handle" or fp.joint is None:
         return None
-    return joint_displacement(world, obj, fp.joint), fp.travel
+    return opening(world, obj, point), fp.travel
 
 
 def opened(world: World, obj: str, point: str | None = None) -> bool:
