@@ -114,6 +114,21 @@ def test_plan_schema_rejects_bad_plans() -> None:
             Plan.model_validate(bad)
 
 
+def test_plan_schema_refuses_drawers_used_out_of_order_or_on_objects_without_one() -> None:
+    stow = next(g for g in GOALS if g.name == "stow_the_soap").plan("stow the soap").model_dump()
+    Plan.model_validate(stow)  # open, put in, shut
+    shut_first = {**stow, "subtasks": [stow["subtasks"][2], stow["subtasks"][1]]}
+    with pytest.raises(ValueError, match="into the drawer of 'cabinet' while it is shut; open it first"):
+        Plan.model_validate(shut_first)
+    never_opened = {**stow, "subtasks": [stow["subtasks"][1]]}
+    with pytest.raises(ValueError, match="while it is shut"):
+        Plan.model_validate(never_opened)
+    soap_drawer = json.loads(json.dumps(stow))
+    soap_drawer["subtasks"][0]["args"]["obj"] = "soap"
+    with pytest.raises(ValueError, match="names 'soap', a soap, which has no drawer"):
+        Plan.model_validate(soap_drawer)
+
+
 # -- LLM planner against a local OpenAI-protocol server ------------------------------------------
 
 @pytest.fixture()

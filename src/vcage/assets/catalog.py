@@ -59,6 +59,11 @@ class ObjectType:
     def functional_point(self, name: str | None = None) -> FunctionalPoint:
         return _find(self.functional_points, name, f"{self.name} functional point")
 
+    @property
+    def drawer_handles(self) -> tuple[FunctionalPoint, ...]:
+        """The handles of its drawers: functional points of kind ``handle`` on a joint."""
+        return tuple(p for p in self.functional_points if p.kind == "handle" and p.joint)
+
     def color(self, variant: str | None = None) -> RGBA:
         if variant is None:
             return next(iter(self.colors.values()))

@@ -494,7 +494,7 @@ def _drawer(obs: Observation, x: str) -> tuple[float, float, bool] | str:
     otype = CATALOG.get(obs.types[x]) if x in obs.types and obs.types[x] in CATALOG else None
     if after is None or otype is None:
         return f"the top view after the subtask and {x}'s type are needed"
-    handles = [p for p in otype.functional_points if p.kind == "handle" and p.joint]
+    handles = otype.drawer_handles
     if not handles:
         return f"{x} ({otype.name}) has no drawer"
     point = next((p for p in handles if p.name == obs.subtask.args.get("point")), handles[0])

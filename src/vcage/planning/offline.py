@@ -112,10 +112,6 @@ class _Objects:
         return tuple(o for _, o in self.items)
 
 
-def _has_drawer(type_: str) -> bool:
-    return any(p.kind == "handle" and p.joint for p in CATALOG.get(type_).functional_points)
-
-
 def _words(o: PlanObject) -> str:
     return f"{o.color + ' ' if o.color else ''}{o.type.replace('_', ' ')}"
 
@@ -288,8 +284,8 @@ class OfflinePlanner:
             ref = parse_phrase(m["obj"], clause)
             _check_colour(ref, ref.type)
             o = objects.resolve(ref, ref.type, clause)
-            if not _has_drawer(o.type):
-                with_drawers = [x.name for x in CATALOG.values() if _has_drawer(x.name)]
+            if not CATALOG.get(o.type).drawer_handles:
+                with_drawers = [x.name for x in CATALOG.values() if x.drawer_handles]
                 raise PlanningError(f"a {o.type.replace('_', ' ')} has no drawer to open or close (in "
                                     f"{bounded(clause)}); objects with a drawer: {', '.join(with_drawers)}")
             if m["verb"] in ("close", "shut"):
@@ -301,7 +297,7 @@ class OfflinePlanner:
             _check_colour(ref, ref.type)
             o = objects.resolve(ref, ref.type, clause)
             fps = CATALOG.get(o.type).functional_points
-            if _has_drawer(o.type):
+            if CATALOG.get(o.type).drawer_handles:
                 raise PlanningError(f"a {o.type.replace('_', ' ')}'s handle opens or closes its drawer, it "
                                     f"is not pressed (in {bounded(clause)}); say 'open the {_words(o)}' or "
                                     f"'close the {_words(o)}'")

@@ -142,12 +142,18 @@ class Plan(_Strict):
         return self
 
     def _drawers_open_when_used(self) -> None:
-        """Something put into a drawer goes in while that drawer is open: every drawer starts shut, an
-        ``open_drawer`` subtask opens it, ``close_drawer`` shuts it."""
+        """Drawers are opened and closed on objects that have one, and something put into a drawer goes
+        in while it is open: every drawer starts shut, an ``open_drawer`` subtask opens it,
+        ``close_drawer`` shuts it."""
         types = {o.name: o.type for o in self.objects}
         opened: set[str] = set()
         for i, st in enumerate(self.subtasks):
             target = st.args.get("target")
+            obj = st.args.get("obj")
+            if st.skill in ("open_drawer", "close_drawer") and isinstance(obj, str) and obj in types \
+                    and not CATALOG.get(types[obj]).drawer_handles:
+                raise ValueError(f"subtask {i} ({st.skill}) names {obj!r}, a {types[obj]}, which has no "
+                                 "drawer")
             if st.skill == "open_drawer":
                 opened.add(str(st.args["obj"]))
             elif st.skill == "close_drawer":

@@ -32,9 +32,11 @@ PAST_SHUT = 0.005  # closing pushes this far past shut: the joint's stop holds t
 
 def handle_of(world: World, obj: str, point: str | None = None) -> FunctionalPoint:
     """``obj``'s drawer handle (its functional point ``point``); SkillError if it has none."""
-    fp = CATALOG.get(world.object(obj).type_name).functional_point(point)
-    if fp.kind != "handle" or fp.joint is None:
-        raise SkillError(f"{obj!r} has no drawer handle (its functional point {fp.name!r} is a {fp.kind})")
+    otype = CATALOG.get(world.object(obj).type_name)
+    fp = next((p for p in otype.drawer_handles if point is None or p.name == point), None)
+    if fp is None:
+        raise SkillError(f"{obj!r} ({otype.name}) has no drawer handle"
+                         + (f" named {point!r}" if point else "") + "; objects with a drawer have one")
     return fp
 
 

@@ -152,10 +152,11 @@ def pressed(world: World, obj: str, point: str | None = None) -> bool:
 def _drawer_out(world: World, obj: str, point: str | None) -> tuple[float, float] | None:
     """How far ``obj``'s drawer is out (signed: a drawer pushed past its stop is further in than
     shut, not out) and how far counts as open; None if it has no drawer."""
-    fp = CATALOG.get(world.object(obj).type_name).functional_point(point)
-    if fp.kind != "handle" or fp.joint is None:
+    handles = CATALOG.get(world.object(obj).type_name).drawer_handles
+    fp = next((p for p in handles if point is None or p.name == point), None)
+    if fp is None:
         return None
-    return opening(world, obj, point), fp.travel
+    return opening(world, obj, fp.name), fp.travel
 
 
 def opened(world: World, obj: str, point: str | None = None) -> bool:
