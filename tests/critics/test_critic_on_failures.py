@@ -161,6 +161,26 @@ def test_a_mouse_on_its_back_on_the_pad_is_not_on_it() -> None:
     assert not verdict.accept and "turned over" in verdict.reason, verdict.reason
 
 
+def test_a_mouse_standing_on_its_end_on_the_pad_is_not_on_it() -> None:
+    """Vanilla rollouts left mice standing on an end or propped on clutter on the pad: from the top
+    they lie over it, their lowest point is down on it and their top is no flatter than before. The
+    "after" views here are of the pad with the mouse stood on its end and settled (as for the mouse on
+    its back); its top now stands 5 cm higher than a mouse put down on the pad reaches."""
+    done = run(MOUSE_PAD, put_on("mouse", "pad", "the mouse is on the pad"))
+    assert done.success and CRITIC.judge(done.obs).accept
+    world = compose(SceneSpec(objects=(O("mouse", "mouse", (0.55, 0.12), z=0.85), MOUSE_PAD[1]))).make_world()
+    adr = world.model.jnt_qposadr[world.model.body_jntadr[world.object("mouse").body_id]]
+    world.data.qpos[adr + 3:adr + 7] = (np.cos(np.pi / 4), 0.0, np.sin(np.pi / 4), 0.0)  # quarter turn, y
+    world.forward()
+    world.settle(1.0)
+    assert not P.on(world, "mouse", "pad")
+    with Renderer(world, 320, 240) as renderer:
+        after = render_views(renderer)
+    verdict = CRITIC.judge(replace(done.obs, after=after))
+    assert not verdict.accept and "higher than mouse standing on pad's surface reaches" in verdict.reason, \
+        verdict.reason
+
+
 def test_a_block_put_down_where_another_stands_is_not_on_the_table() -> None:
     """Put down at a spot another block of its size occupies, the block comes to rest on it: from the
     top it shows where it should, and its neighbour, no larger, mostly hides under it. The heights of

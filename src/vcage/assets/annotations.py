@@ -53,7 +53,8 @@ class Placement:
     ``pos`` is the centre of the region at the height of its supporting surface; ``half_size`` its
     half extents in x and y; ``wall_height`` the height of the containing walls for ``in``.
     ``joint`` names a slide joint along the object's x axis that the region rides on (a drawer's
-    inside comes out with the drawer); ``pos`` is where it is at the joint's zero.
+    inside comes out with the drawer); ``pos`` is where it is at the joint's zero. ``slope`` is how
+    far (radians) the supporting surface leans (a stand's ramp): what rests there leans with it.
     """
 
     name: str
@@ -62,6 +63,7 @@ class Placement:
     half_size: tuple[float, float]
     wall_height: float = 0.0
     joint: str | None = None
+    slope: float = 0.0
 
 
 @dataclass(frozen=True)

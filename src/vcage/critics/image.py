@@ -92,6 +92,7 @@ HEIGHT_RATIO = 0.8  # front-view height after / before for an object that stayed
 # the other object
 SUPPORT_TOL = 0.02
 HEIGHT_TOL = 0.01
+TOP_TOL = 0.01
 UNDER_PX = 4
 # A placed object's top keeps its shape: one whose top lay at least CURVED metres (RMS) from a plane
 # before the subtask and under FLAT_TOP of that after it shows a flat face it did not show before
@@ -229,14 +230,20 @@ def _landed_on_other(obs: Observation, top: View, a: str, b: str, inside: bool) 
         return None
     rim = float(hb[_inner(mb)].max())
     surface = rim if inside else _surface(obs, b, rim)
-    return _not_down(obs, top, a, surface, rim, f"{b}'s {'rim' if inside else 'surface'}", (a, b))
+    btype = CATALOG.get(obs.types[b]) if obs.types.get(b) in CATALOG else None
+    leans = btype is not None and bool(btype.placements) and btype.placements[0].slope > 0
+    return _not_down(obs, top, a, surface, rim, f"{b}'s {'rim' if inside else 'surface'}", (a, b),
+                     standing=not leans)
 
 
 def _not_down(obs: Observation, top: View, a: str, surface: float | None, floor: float, where: str,
-              skip: tuple[str, ...]) -> str | None:
+              skip: tuple[str, ...], standing: bool = False) -> str | None:
     """Why ``a`` cannot rest on a support whose surface lies ``surface`` above the table (``where``
     names it), from the top view's heights; None if they allow it (or cannot tell). Without a known
-    surface only clutter higher than ``floor`` counts (see :func:`_landed_on_other`)."""
+    surface only clutter higher than ``floor`` counts (see :func:`_landed_on_other`). ``standing``:
+    ``a`` stands there as it stood before (put down by the hand, on a surface that does not lean), so
+    its top can be no higher than its type's height above the surface either (tipped onto a side, or
+    propped on something, it stands taller)."""
     before = obs.before.get(TOP)
     hb, ha = (_heights(before), _heights(top)) if before is not None else (None, None)
     ma = _mask(obs, top, a)
@@ -247,6 +254,9 @@ def _not_down(obs: Observation, top: View, a: str, surface: float | None, floor:
         above = float(ha[ma].min()) - height - surface
         if above > HEIGHT_TOL:
             return f"{a} stands {100 * above:.1f} cm higher than resting on {where} allows"
+        taller = float(np.percentile(ha[_inner(ma)], 95)) - height - surface
+        if standing and taller > TOP_TOL:
+            return f"{a}'s top is {100 * taller:.1f} cm higher than {a} standing on {where} reaches"
     surface = floor if surface is None else surface
     for i, c in enumerate(obs.labels):
         was = before.segmentation == i

@@ -145,7 +145,8 @@ CATALOG.add_type(ObjectType(
     build=_phone_stand, tags=frozenset({"office", "support", "stand"}),
     annotations=Annotations(
         placements=(Placement("slot", "on", (round(_SLOT_X, 4), 0.0, round(float(_RAMP_TOP[1]), 4)),
-                              (round(STAND_RAMP[0] * math.cos(STAND_SLOPE), 4), STAND_HALF_Y - 0.005)),),
+                              (round(STAND_RAMP[0] * math.cos(STAND_SLOPE), 4), STAND_HALF_Y - 0.005),
+                              slope=STAND_SLOPE),),
     ),
 ))
 
