@@ -14,6 +14,7 @@ import numpy as np
 import pytest
 
 from critics.faulted import Run, run
+from vcage.critics.base import Verdict
 from vcage.critics.image import ROBOT, ImageCritic
 from vcage.critics.masks import touch
 from vcage.planning.goals import close_drawer, open_drawer, press, put_in, put_on
@@ -142,41 +143,35 @@ def test_an_object_put_down_on_clutter_that_lies_on_its_target_is_not_on_it() ->
     assert "mouse lies over block" in verdict.reason
 
 
-def test_a_mouse_on_its_back_on_the_pad_is_not_on_it() -> None:
-    """Vanilla rollouts left mice on their backs on the pad (the oracle: not on it; its outline from
-    the top is the same). No injected fault turns one over reliably, so the "after" views here are of
-    the same pad with the mouse set on its back and settled; the "before" views are the rollout's.
-    The mouse's domed top was far from a plane; its flat underside is not."""
+def _mouse_set_on_the_pad(quat: tuple[float, float, float, float], z: float) -> Verdict:
+    """The critic's verdict on a mouse put on the pad as planned, with the "after" views replaced by
+    the same pad with the mouse dropped from ``z`` in orientation ``quat`` and settled (no injected
+    fault leaves a mouse in such a pose reliably); the oracle must say it is not on the pad."""
     done = run(MOUSE_PAD, put_on("mouse", "pad", "the mouse is on the pad"))
     assert done.success and CRITIC.judge(done.obs).accept
-    world = compose(SceneSpec(objects=(O("mouse", "mouse", (0.55, 0.12), z=0.9), MOUSE_PAD[1]))).make_world()
+    world = compose(SceneSpec(objects=(O("mouse", "mouse", (0.55, 0.12), z=z), MOUSE_PAD[1]))).make_world()
     adr = world.model.jnt_qposadr[world.model.body_jntadr[world.object("mouse").body_id]]
-    world.data.qpos[adr + 3:adr + 7] = (0.0, 1.0, 0.0, 0.0)  # half a turn about x
+    world.data.qpos[adr + 3:adr + 7] = quat
     world.forward()
     world.settle(1.0)
     assert not P.on(world, "mouse", "pad")
     with Renderer(world, 320, 240) as renderer:
         after = render_views(renderer)
-    verdict = CRITIC.judge(replace(done.obs, after=after))
+    return CRITIC.judge(replace(done.obs, after=after))
+
+
+def test_a_mouse_on_its_back_on_the_pad_is_not_on_it() -> None:
+    """Vanilla rollouts left mice on their backs on the pad (the oracle: not on it; its outline from
+    the top is the same). The mouse's domed top was far from a plane; its flat underside is not."""
+    verdict = _mouse_set_on_the_pad((0.0, 1.0, 0.0, 0.0), 0.9)  # half a turn about x
     assert not verdict.accept and "turned over" in verdict.reason, verdict.reason
 
 
 def test_a_mouse_standing_on_its_end_on_the_pad_is_not_on_it() -> None:
     """Vanilla rollouts left mice standing on an end or propped on clutter on the pad: from the top
-    they lie over it, their lowest point is down on it and their top is no flatter than before. The
-    "after" views here are of the pad with the mouse stood on its end and settled (as for the mouse on
-    its back); its top now stands 5 cm higher than a mouse put down on the pad reaches."""
-    done = run(MOUSE_PAD, put_on("mouse", "pad", "the mouse is on the pad"))
-    assert done.success and CRITIC.judge(done.obs).accept
-    world = compose(SceneSpec(objects=(O("mouse", "mouse", (0.55, 0.12), z=0.85), MOUSE_PAD[1]))).make_world()
-    adr = world.model.jnt_qposadr[world.model.body_jntadr[world.object("mouse").body_id]]
-    world.data.qpos[adr + 3:adr + 7] = (np.cos(np.pi / 4), 0.0, np.sin(np.pi / 4), 0.0)  # quarter turn, y
-    world.forward()
-    world.settle(1.0)
-    assert not P.on(world, "mouse", "pad")
-    with Renderer(world, 320, 240) as renderer:
-        after = render_views(renderer)
-    verdict = CRITIC.judge(replace(done.obs, after=after))
+    they lie over it, their lowest point is down on it and their top is no flatter than before. Stood
+    on its end, its top stands 5 cm higher than a mouse put down on the pad reaches."""
+    verdict = _mouse_set_on_the_pad((np.cos(np.pi / 4), 0.0, np.sin(np.pi / 4), 0.0), 0.85)  # about y
     assert not verdict.accept and "higher than mouse standing on pad's surface reaches" in verdict.reason, \
         verdict.reason
 
