@@ -250,13 +250,14 @@ def _not_down(obs: Observation, top: View, a: str, surface: float | None, floor:
     if before is None or hb is None or ha is None or not ma.any():
         return None
     height = _max_height(obs, a)
+    too_tall = None  # said after the clutter under ``a``, which says more
     if surface is not None and height is not None:
         above = float(ha[ma].min()) - height - surface
         if above > HEIGHT_TOL:
             return f"{a} stands {100 * above:.1f} cm higher than resting on {where} allows"
         taller = float(np.percentile(ha[_inner(ma)], 95)) - height - surface
         if standing and taller > TOP_TOL:
-            return f"{a}'s top is {100 * taller:.1f} cm higher than {a} standing on {where} reaches"
+            too_tall = f"{a}'s top is {100 * taller:.1f} cm higher than {a} standing on {where} reaches"
     surface = floor if surface is None else surface
     for i, c in enumerate(obs.labels):
         was = before.segmentation == i
@@ -272,7 +273,7 @@ def _not_down(obs: Observation, top: View, a: str, surface: float | None, floor:
         rise = float(np.median(shift(np.where(was, hb, 0.0), dr, dc)[under])) - surface
         if rise > SUPPORT_TOL:
             return f"{a} lies over {c}, whose top is {100 * rise:.1f} cm above {where}"
-    return None
+    return too_tall
 
 
 def _relief(view: View, mask: np.ndarray) -> float | None:
