@@ -82,15 +82,23 @@ def slide(s: Skills, obj: str, to: float, point: str | None = None, name: str = 
     return MotionPlan(name, tuple(wps))
 
 
+def goal_opening(world: World, obj: str, skill: str, point: str | None = None,
+                 distance: float | None = None) -> float:
+    """How far out ``skill`` (``open_drawer`` or ``close_drawer``) slides ``obj``'s drawer."""
+    if skill == "close_drawer":
+        return -PAST_SHUT
+    if distance is not None:
+        return float(distance)
+    return handle_of(world, obj, point).stroke * world.object(obj).scale
+
+
 @SKILLS.register("open_drawer")
 def open_drawer(s: Skills, obj: str, point: str | None = None, distance: float | None = None) -> MotionPlan:
     """Pull ``obj``'s drawer out by its handle to ``distance`` metres (default: the handle's stroke)."""
-    fp = handle_of(s.world, obj, point)
-    return slide(s, obj, fp.stroke * s.world.object(obj).scale if distance is None else float(distance),
-                 point, "open_drawer")
+    return slide(s, obj, goal_opening(s.world, obj, "open_drawer", point, distance), point, "open_drawer")
 
 
 @SKILLS.register("close_drawer")
 def close_drawer(s: Skills, obj: str, point: str | None = None) -> MotionPlan:
     """Push ``obj``'s drawer shut by its handle."""
-    return slide(s, obj, -PAST_SHUT, point, "close_drawer")
+    return slide(s, obj, goal_opening(s.world, obj, "close_drawer", point), point, "close_drawer")

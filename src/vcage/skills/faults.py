@@ -38,7 +38,7 @@ from vcage.skills.base import (
     TCP_MIN_ABOVE_TABLE,
     Skills,
 )
-from vcage.skills.drawers import PAST_SHUT, handle_of, opening, slide
+from vcage.skills.drawers import goal_opening, opening, slide
 from vcage.skills.motion import MotionPlan, Waypoint
 from vcage.skills.primitives import lift, move_line, placement_target, press, push, shake, turn_and_place
 
@@ -327,12 +327,7 @@ def _stop_short(s: Skills, skill: str, args: Args, rng: np.random.Generator) -> 
 def _pull_short(s: Skills, skill: str, args: Args, rng: np.random.Generator) -> MotionPlan:
     obj, point = str(args["obj"]), args.get("point")
     now = opening(s.world, obj, point)
-    if skill == "close_drawer":
-        to = -PAST_SHUT
-    elif args.get("distance") is not None:
-        to = float(args["distance"])
-    else:
-        to = handle_of(s.world, obj, point).stroke * s.world.object(obj).scale
+    to = goal_opening(s.world, obj, skill, point, args.get("distance"))
     return slide(s, obj, now + rng.uniform(0.3, 0.6) * (to - now), point, skill)
 
 
