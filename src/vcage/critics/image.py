@@ -14,9 +14,11 @@ simulator state. Each predicate is checked in image space:
   top view's depth, ``a`` is down on ``b``: its lowest point is no higher than its type's height
   above ``b``'s surface (for ``inside``, its rim), and it does not lie over another object that
   stood higher than that surface before the subtask (clutter on the target); an object that stood on
-  its base with a curved top before and shows a flat one now lies turned over. In a drawer (a
-  placement that comes out with a joint) ``a`` also lies over what came out of ``b``, not on its
-  body, and lower than the drawer's rim.
+  its base with a curved top before and shows a flat one now lies turned over. Put down on a surface
+  that does not lean, ``a``'s top stands no higher than its type's height above that surface. In a
+  drawer (a placement that comes out with a joint) the drawer is still open after the subtask, and
+  ``a`` lies over what came out of ``b`` (not on its body), below the drawer's rim, and no lower
+  than lying on the drawer's floor makes it.
 - ``released(a)``: after the retreat, the robot does not touch ``a`` in every view that shows it
   (a projection overlap in one view is not contact); ``a`` hidden in every view is not released.
 - ``pressed(x)``: in the views at the subtask's deepest moment the robot touches ``x`` (front view,
@@ -159,6 +161,12 @@ class ImageCritic(Critic):
 
 # -- masks ----------------------------------------------------------------------------------------
 
+def _type_of(obs: Observation, name: str) -> ObjectType | None:
+    """``name``'s catalog type, as the plan gives it (None if it does not, or names no catalog type)."""
+    type_name = obs.types.get(name)
+    return CATALOG.get(type_name) if type_name is not None and type_name in CATALOG else None
+
+
 def _mask(obs: Observation, view: View, name: str) -> np.ndarray:
     return view.segmentation == obs.labels.index(name)
 
@@ -230,7 +238,7 @@ def _landed_on_other(obs: Observation, top: View, a: str, b: str, inside: bool) 
         return None
     rim = float(hb[_inner(mb)].max())
     surface = rim if inside else _surface(obs, b, rim)
-    btype = CATALOG.get(obs.types[b]) if obs.types.get(b) in CATALOG else None
+    btype = _type_of(obs, b)
     leans = btype is not None and bool(btype.placements) and btype.placements[0].slope > 0
     return _not_down(obs, top, a, surface, rim, f"{b}'s {'rim' if inside else 'surface'}", (a, b),
                      standing=not leans)
@@ -294,7 +302,7 @@ def _turned_over(obs: Observation, top: View, a: str) -> str | None:
     from a plane), and its top is now nearly flat (under :data:`FLAT_TOP` of that), as a mouse on its
     back shows its flat underside. Containers are left out: how much of their inside shows changes
     with what stands around them."""
-    otype = CATALOG.get(obs.types[a]) if obs.types.get(a) in CATALOG else None
+    otype = _type_of(obs, a)
     before = obs.before.get(TOP)
     if (otype is None or before is None or before.pixel_size is None
             or any(p.kind == "in" for p in otype.placements)):
@@ -314,7 +322,7 @@ def _turned_over(obs: Observation, top: View, a: str) -> str | None:
 def _surface(obs: Observation, b: str, top: float) -> float | None:
     """Height of ``b``'s placement surface above the table, from its highest point ``top`` and its
     type (the surface lies below the top by the type's height above it, at the smallest scale)."""
-    otype = CATALOG.get(obs.types[b]) if obs.types.get(b) in CATALOG else None
+    otype = _type_of(obs, b)
     if otype is None or not otype.placements:
         return None
     return top - (otype.size[2] - otype.placements[0].pos[2]) * otype.scale_range[0]
@@ -322,7 +330,7 @@ def _surface(obs: Observation, b: str, top: float) -> float | None:
 
 def _max_height(obs: Observation, a: str) -> float | None:
     """``a``'s height above its resting face at the largest scale of its type."""
-    otype = CATALOG.get(obs.types[a]) if obs.types.get(a) in CATALOG else None
+    otype = _type_of(obs, a)
     return otype.size[2] * otype.scale_range[1] if otype is not None else None
 
 
@@ -358,7 +366,7 @@ def _on(obs: Observation, a: str, b: str) -> tuple[bool, str]:
 
 def _inside(obs: Observation, a: str, b: str) -> tuple[bool, str]:
     ok, why = _rests_on(obs, a, b, inside=True)
-    otype = CATALOG.get(obs.types[b]) if obs.types.get(b) in CATALOG else None
+    otype = _type_of(obs, b)
     drawer = next((p for p in otype.placements if p.kind == "in" and p.joint), None) if otype else None
     if not ok or drawer is None:
         return ok, why
@@ -466,7 +474,7 @@ def _press_shortfall(obs: Observation, x: str) -> float | None:
     """How far (metres) the hand stayed above :data:`PRESS_SHARE` of a full press of ``x`` at its
     lowest (negative: deep enough); None where the views or ``x``'s type cannot tell."""
     before, during = obs.before.get(TOP), obs.during.get(TOP)
-    otype = CATALOG.get(obs.types[x]) if x in obs.types and obs.types[x] in CATALOG else None
+    otype = _type_of(obs, x)
     if before is None or during is None or otype is None:
         return None
     point = next((p for p in otype.functional_points if p.joint and p.name == obs.subtask.args.get("point")),
@@ -502,7 +510,7 @@ def _drawer(obs: Observation, x: str) -> tuple[float, float, bool] | str:
     (the size scaled by the object's height over its type's).
     """
     after = obs.after.get(TOP)
-    otype = CATALOG.get(obs.types[x]) if x in obs.types and obs.types[x] in CATALOG else None
+    otype = _type_of(obs, x)
     if after is None or otype is None:
         return f"the top view after the subtask and {x}'s type are needed"
     handles = otype.drawer_handles
@@ -534,7 +542,8 @@ def _in_drawer(obs: Observation, a: str, b: str, place: Placement) -> tuple[bool
     before, after = obs.before.get(TOP), obs.after.get(TOP)
     hb = _heights(before) if before is not None else None
     ha = _heights(after) if after is not None else None
-    otype = CATALOG.get(obs.types[b])
+    otype = _type_of(obs, b)
+    assert otype is not None  # _inside found b's drawer in it
     if before is None or after is None or hb is None or ha is None:
         return False, "the top view's heights before and after are needed"
     mb, ma = _mask(obs, before, b), _mask(obs, after, a)
@@ -554,7 +563,7 @@ def _in_drawer(obs: Observation, a: str, b: str, place: Placement) -> tuple[bool
     low = float(ha[ma].min())
     if low > rim:
         return False, f"{a} lies {100 * (low - rim):.1f} cm higher than the rim of {b}'s drawer"
-    atype = CATALOG.get(obs.types[a]) if obs.types.get(a) in CATALOG else None
+    atype = _type_of(obs, a)
     if atype is not None:
         a_top = float(np.percentile(ha[_inner(ma)], 95))
         least = floor + atype.size[2] * atype.scale_range[0] - FLOOR_TOL
