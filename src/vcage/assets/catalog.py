@@ -64,6 +64,10 @@ class ObjectType:
         """The handles of its drawers: functional points of kind ``handle`` on a joint."""
         return tuple(p for p in self.functional_points if p.kind == "handle" and p.joint)
 
+    def drawer_handle(self, name: str | None = None) -> FunctionalPoint | None:
+        """Its drawer handle ``name`` (None: the first); None if it has no such handle."""
+        return next((p for p in self.drawer_handles if name is None or p.name == name), None)
+
     def color(self, variant: str | None = None) -> RGBA:
         if variant is None:
             return next(iter(self.colors.values()))

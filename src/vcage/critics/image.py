@@ -513,10 +513,9 @@ def _drawer(obs: Observation, x: str) -> tuple[float, float, bool] | str:
     otype = _type_of(obs, x)
     if after is None or otype is None:
         return f"the top view after the subtask and {x}'s type are needed"
-    handles = otype.drawer_handles
-    if not handles:
+    point = otype.drawer_handle(obs.subtask.args.get("point")) or otype.drawer_handle()
+    if point is None:
         return f"{x} ({otype.name}) has no drawer"
-    point = next((p for p in handles if p.name == obs.subtask.args.get("point")), handles[0])
     heights, mask = _heights(after), _mask(obs, after, x)
     if heights is None or after.pixel_size is None or mask.sum() < MIN_RELIEF_PX:
         return f"{x} is not seen in the top view's heights"

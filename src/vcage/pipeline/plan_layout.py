@@ -115,10 +115,10 @@ def _drawers_slid(plan: Plan, scales: dict[str, float]) -> dict[str, float]:
         if st.skill not in DRAWER_SKILLS:
             continue
         name = str(st.args["obj"])
-        handles = CATALOG.get(types[name]).drawer_handles
-        if not handles:  # the plan's check refuses this; the skill would raise
+        otype = CATALOG.get(types[name])
+        handle = otype.drawer_handle(st.args.get("point")) or otype.drawer_handle()
+        if handle is None:  # the plan's check refuses this; the skill would raise
             continue
-        handle = next((p for p in handles if p.name == st.args.get("point")), handles[0])
         far = handle.stroke * scales[name] if st.args.get("distance") is None else float(st.args["distance"])
         out[name] = max(out.get(name, 0.0), far)
     return out
@@ -129,7 +129,8 @@ def _drawer_pose(type_: str, scale: float, out: float,
     """The region and yaw range of an object whose drawer comes ``out`` metres towards the robot
     (-x): its handle faces the robot, and the drawer's front stays in ``work_area``."""
     otype = CATALOG.get(type_)
-    handle = otype.drawer_handles[0]
+    handle = otype.drawer_handle()
+    assert handle is not None  # only objects with a drawer get here
     way_out = math.atan2(handle.direction[1], handle.direction[0])  # in the object's frame
     facing = math.pi - way_out  # the yaw that turns the way out towards -x
     half_depth = otype.size[0 if abs(math.cos(way_out)) > 0.5 else 1] * scale / 2

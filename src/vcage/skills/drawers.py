@@ -33,7 +33,7 @@ PAST_SHUT = 0.005  # closing pushes this far past shut: the joint's stop holds t
 def handle_of(world: World, obj: str, point: str | None = None) -> FunctionalPoint:
     """``obj``'s drawer handle (its functional point ``point``); SkillError if it has none."""
     otype = CATALOG.get(world.object(obj).type_name)
-    fp = next((p for p in otype.drawer_handles if point is None or p.name == point), None)
+    fp = otype.drawer_handle(point)
     if fp is None:
         raise SkillError(f"{obj!r} ({otype.name}) has no drawer handle"
                          + (f" named {point!r}" if point else "") + "; objects with a drawer have one")

@@ -152,8 +152,7 @@ def pressed(world: World, obj: str, point: str | None = None) -> bool:
 def _drawer_out(world: World, obj: str, point: str | None) -> tuple[float, float] | None:
     """How far ``obj``'s drawer is out (signed: a drawer pushed past its stop is further in than
     shut, not out) and how far counts as open; None if it has no drawer."""
-    handles = CATALOG.get(world.object(obj).type_name).drawer_handles
-    fp = next((p for p in handles if point is None or p.name == point), None)
+    fp = CATALOG.get(world.object(obj).type_name).drawer_handle(point)
     if fp is None:
         return None
     return opening(world, obj, fp.name), fp.travel

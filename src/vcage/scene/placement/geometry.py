@@ -50,7 +50,7 @@ def drawer_zone(type_name: str, scale: float, yaw: float, out: float, xy: tuple[
     handle's direction, as wide as the object, and the hand's reach beyond the handle there (the
     fingers close along the slide), grown by ``slack``. Empty without a drawer handle."""
     otype = CATALOG.get(type_name)
-    handle = next((p for p in otype.functional_points if p.kind == "handle" and p.joint), None)
+    handle = otype.drawer_handle()
     if handle is None or out <= 0:
         return EMPTY
     sx, sy = (s * scale / 2 for s in otype.size[:2])
