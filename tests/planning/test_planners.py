@@ -104,6 +104,8 @@ def test_plan_schema_rejects_bad_plans() -> None:
         (("subtasks", 0, "args"), {"obj": "ghost"}, "unknown object"),
         (("subtasks", 0, "args"), {"obj": "clock", "speed": 3}, "has no argument"),
         (("subtasks", 0, "predicates"), [{"name": "on", "args": ["clock"]}], "takes 2..2 objects"),
+        (("subtasks", 1, "args"), {"obj": "phone", "target": "stand", "placement": "roof"},
+         r"names placement 'roof' of 'stand'; its placements: \['slot'\]"),
     ]:
         bad = json.loads(json.dumps(good, default=list))
         node = bad

@@ -138,6 +138,12 @@ class Plan(_Strict):
             if unknown:
                 raise ValueError(f"subtask {i} ({st.skill}) names unknown object(s) {unknown}; "
                                  f"plan objects: {names}")
+            target, place = st.args.get("target"), st.args.get("placement")
+            if isinstance(target, str) and place is not None:
+                valid = [p.name for p in CATALOG.get(self.object(target).type).placements]
+                if place not in valid:
+                    raise ValueError(f"subtask {i} ({st.skill}) names placement {place!r} of {target!r}; "
+                                     f"its placements: {valid}")
         self._drawers_open_when_used()
         return self
 
@@ -159,8 +165,7 @@ class Plan(_Strict):
             elif st.skill == "close_drawer":
                 opened.discard(str(st.args["obj"]))
             elif st.skill == "pick_and_place" and isinstance(target, str) and target in types \
-                    and target not in opened \
-                    and CATALOG.get(types[target]).placement(st.args.get("placement")).joint is not None:
+                    and target not in opened and _in_a_drawer(types[target], st.args.get("placement")):
                 raise ValueError(f"subtask {i} puts {st.args['obj']!r} into the drawer of {target!r} "
                                  f"while it is shut; open it first (an open_drawer subtask of {target!r} "
                                  "before it)")
@@ -179,6 +184,12 @@ class Plan(_Strict):
             preds = ", ".join(str(p) for p in st.predicates)
             lines.append(f"{i}. {st.skill}({args}): {st.description}  [{preds}]")
         return "\n".join(lines)
+
+
+def _in_a_drawer(type_name: str, placement: str | None) -> bool:
+    """Whether placement ``placement`` (None: the first) of ``type_name`` is a drawer's inside."""
+    places = CATALOG.get(type_name).placements
+    return bool(places) and CATALOG.get(type_name).placement(placement).joint is not None
 
 
 def plan_json_schema() -> dict[str, Any]:
