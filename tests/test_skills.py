@@ -93,3 +93,28 @@ def test_skill_errors_are_typed(world: World) -> None:
         skills.do("place", obj="a")
     with pytest.raises(SkillError):
         skills.do("move_to", pos=np.array([1.6, 0.0, 0.9]))
+
+
+def test_what_is_put_into_a_drawer_lies_across_it_so_the_drawer_shuts() -> None:
+    """A sponge standing lengthwise to the drawer's slide is turned on its way in, its long side
+    across the drawer; the drawer then shuts with it inside. A drawer skill on an object without
+    one is a typed error."""
+    from vcage.assets.catalog import CATALOG
+    from vcage.geometry import wrap_angle, yaw_of
+    from vcage.scene.compose import compose
+    from vcage.scene.spec import ObjectSpec, SceneSpec
+
+    world = compose(SceneSpec(objects=(ObjectSpec("cab", "cabinet", (0.68, 0.0), yaw=0.2),
+                                       ObjectSpec("sponge", "sponge", (0.5, 0.22), yaw=0.2)))).make_world()
+    world.settle(0.3)
+    sx, sy = CATALOG.get("sponge").size[:2]
+    assert sx > sy  # its long side along its own x: lengthwise to the cabinet's slide at first
+    skills = Skills(world)
+    skills.do("open_drawer", obj="cab")
+    skills.do("pick_and_place", obj="sponge", target="cab")
+    across = wrap_angle(yaw_of(world.object_mat("sponge")) - yaw_of(world.object_mat("cab")) - np.pi / 2)
+    assert abs(wrap_angle(2 * across)) / 2 < 0.2  # within 0.2 rad of across, either way round
+    skills.do("close_drawer", obj="cab")
+    assert P.closed(world, "cab") and P.inside(world, "sponge", "cab")
+    with pytest.raises(SkillError, match="'sponge' \\(sponge\\) has no drawer handle"):
+        skills.do("open_drawer", obj="sponge")

@@ -11,7 +11,7 @@ import numpy as np
 
 from vcage.assets.catalog import CATALOG
 from vcage.errors import SkillError
-from vcage.geometry import rot_z, yaw_of
+from vcage.geometry import rot_z, wrap_angle, yaw_of
 from vcage.sim.robot import HOME_QPOS
 from vcage.skills.base import (
     APPROACH,
@@ -28,6 +28,8 @@ from vcage.skills.base import (
 from vcage.skills.drawers import slid
 from vcage.skills.ik import down_rotation
 from vcage.skills.motion import MotionPlan, Waypoint
+
+PLACE_CLEARANCE = 0.012  # metres above its resting height at which a placed object is let go
 
 
 # -- the primitives ------------------------------------------------------------------------------
@@ -99,7 +101,7 @@ def placement_target(s: Skills, target: str, placement: str | None = None) -> tu
 
 @SKILLS.register("place")
 def place(s: Skills, obj: str, target: str | None = None, placement: str | None = None,
-          xy: tuple[float, float] | None = None, clearance: float = 0.012,
+          xy: tuple[float, float] | None = None, clearance: float = PLACE_CLEARANCE,
           yaw: float | None = None, offset: np.ndarray | None = None) -> MotionPlan:
     """Put the held ``obj`` onto ``target``'s placement annotation (or the table at ``xy``) and release.
 
@@ -140,8 +142,23 @@ def pick_and_place(s: Skills, obj: str, target: str | None = None, placement: st
     with s.after(plan):
         plan = plan + lift(s)
     with s.after(plan):
-        plan = plan + place(s, obj, target, placement, xy, offset=offset)
+        if target is not None and CATALOG.get(s.world.object(target).type_name).placement(placement).joint:
+            plan = plan + _across_drawer(s, obj, target, placement, offset)
+        else:
+            plan = plan + place(s, obj, target, placement, xy, offset=offset)
     return MotionPlan("pick_and_place", plan.waypoints)
+
+
+def _across_drawer(s: Skills, obj: str, target: str, placement: str | None, offset: np.ndarray) -> MotionPlan:
+    """Put the held ``obj`` (origin at ``offset`` from the TCP) into ``target``'s open drawer with its
+    long side across the drawer's slide, turning the hand by the smallest turn that does it: put in
+    lengthwise, an object can catch on the body when the drawer is pushed shut."""
+    surface, host_yaw = placement_target(s, target, placement)
+    sx, sy = CATALOG.get(s.world.object(obj).type_name).size[:2]
+    long_axis = yaw_of(s.world.object_mat(obj)) + (0.0 if sx >= sy else math.pi / 2)
+    turn = wrap_angle(2 * wrap_angle(host_yaw + math.pi / 2 - long_axis)) / 2  # the drawer slides along x
+    _, hand_yaw = s.tcp()
+    return _lower_and_release(s, surface, rot_z(turn) @ offset, hand_yaw + turn, PLACE_CLEARANCE)
 
 
 @SKILLS.register("press")
@@ -203,7 +220,7 @@ def rotate(s: Skills, angle: float) -> MotionPlan:
 @SKILLS.register("turn_and_place")
 def turn_and_place(s: Skills, obj: str, turn: float, target: str | None = None,
                    placement: str | None = None, xy: tuple[float, float] | None = None,
-                   clearance: float = 0.012) -> MotionPlan:
+                   clearance: float = PLACE_CLEARANCE) -> MotionPlan:
     """Put the held ``obj`` down like :func:`place`, turned by ``turn`` radians about the vertical
     (the hand turns by exactly that much, so the object's heading changes by ``turn``)."""
     if target is not None:
