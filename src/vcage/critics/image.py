@@ -14,9 +14,8 @@ simulator state. Each predicate is checked in image space:
   top view's depth, ``a`` is down on ``b``: its lowest point is no higher than its type's height
   above ``b``'s surface (for ``inside``, its rim), and it does not lie over another object that
   stood higher than that surface before the subtask (clutter on the target); an object that stood on
-  its base with a curved top before and shows a flat one now lies turned over. ``a``'s top stands no
-  higher than its type's height above that surface (plus what leaning with a sloped surface such as
-  a stand's adds: half its longest side times the slope's sine) and :data:`TOP_TOL`. In a
+  its base with a curved top before and shows a flat one now lies turned over. Put down on a surface
+  that does not lean, ``a``'s top stands no higher than its type's height above that surface. In a
   drawer (a placement that comes out with a joint) the drawer is still open after the subtask, and
   ``a`` lies over what came out of ``b`` (not on its body), below the drawer's rim, and no lower
   than lying on the drawer's floor makes it.
@@ -198,9 +197,7 @@ def _rests_on(obs: Observation, a: str, b: str, inside: bool) -> tuple[bool, str
     if not ma.any():
         return False, f"{a} is not visible from the top"
     if _covered(obs, top, b):  # from the top ``b`` is (mostly) hidden: where it is, the front view says
-        ok, why = _front_support(obs, front, a, b)
-        other = _landed_on_other(obs, top, a, b, inside) or _turned_over(obs, top, a) if ok else None
-        return (False, other) if other is not None else (ok, why)
+        return _front_support(obs, front, a, b)
     if not mb.any():
         return False, f"{b} is not visible from the top"
     small, big = (ma, mb) if ma.sum() <= mb.sum() else (mb, ma)
@@ -241,22 +238,20 @@ def _landed_on_other(obs: Observation, top: View, a: str, b: str, inside: bool) 
         return None
     rim = float(hb[_inner(mb)].max())
     surface = rim if inside else _surface(obs, b, rim)
-    btype, atype = _type_of(obs, b), _type_of(obs, a)
-    slope = btype.placements[0].slope if btype is not None and btype.placements else 0.0
-    # leaning with the surface, ``a`` stands taller by up to half its longest side times the slope's sine
-    lean = max(atype.size[:2]) * atype.scale_range[1] / 2 * np.sin(slope) if atype is not None else 0.0
+    btype = _type_of(obs, b)
+    leans = btype is not None and bool(btype.placements) and btype.placements[0].slope > 0
     return _not_down(obs, top, a, surface, rim, f"{b}'s {'rim' if inside else 'surface'}", (a, b),
-                     top_slack=TOP_TOL + lean)
+                     standing=not leans)
 
 
 def _not_down(obs: Observation, top: View, a: str, surface: float | None, floor: float, where: str,
-              skip: tuple[str, ...], top_slack: float | None = None) -> str | None:
+              skip: tuple[str, ...], standing: bool = False) -> str | None:
     """Why ``a`` cannot rest on a support whose surface lies ``surface`` above the table (``where``
     names it), from the top view's heights; None if they allow it (or cannot tell). Without a known
-    surface only clutter higher than ``floor`` counts (see :func:`_landed_on_other`). With
-    ``top_slack``, ``a`` stands there as it stood before (put down by the hand), so its top can be no
-    higher than its type's height above the surface plus ``top_slack`` either (tipped onto a side,
-    or propped on something, it stands taller)."""
+    surface only clutter higher than ``floor`` counts (see :func:`_landed_on_other`). ``standing``:
+    ``a`` stands there as it stood before (put down by the hand, on a surface that does not lean), so
+    its top can be no higher than its type's height above the surface either (tipped onto a side, or
+    propped on something, it stands taller)."""
     before = obs.before.get(TOP)
     hb, ha = (_heights(before), _heights(top)) if before is not None else (None, None)
     ma = _mask(obs, top, a)
@@ -269,7 +264,7 @@ def _not_down(obs: Observation, top: View, a: str, surface: float | None, floor:
         if above > HEIGHT_TOL:
             return f"{a} stands {100 * above:.1f} cm higher than resting on {where} allows"
         taller = float(np.percentile(ha[_inner(ma)], 95)) - height - surface
-        if top_slack is not None and taller > top_slack:
+        if standing and taller > TOP_TOL:
             too_tall = f"{a}'s top is {100 * taller:.1f} cm higher than {a} standing on {where} reaches"
     surface = floor if surface is None else surface
     for i, c in enumerate(obs.labels):
