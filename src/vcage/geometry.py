@@ -77,6 +77,12 @@ def wrap_angle(a: float) -> float:
     return (a + math.pi) % (2 * math.pi) - math.pi
 
 
+def wrap_half_turn(a: float) -> float:
+    """The smallest turn, within +-pi/2, equal to ``a`` up to half turns (for headings of objects
+    that look the same turned by pi)."""
+    return wrap_angle(2 * wrap_angle(a)) / 2
+
+
 def look_at_quat(pos: np.ndarray, target: np.ndarray,
                  up: tuple[float, float, float] = (0.0, 0.0, 1.0)) -> np.ndarray:
     """Orientation of a MuJoCo camera (looking along its -z) at ``pos`` aimed at ``target``.

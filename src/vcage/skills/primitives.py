@@ -11,7 +11,7 @@ import numpy as np
 
 from vcage.assets.catalog import CATALOG
 from vcage.errors import SkillError
-from vcage.geometry import rot_z, wrap_angle, yaw_of
+from vcage.geometry import rot_z, wrap_half_turn, yaw_of
 from vcage.sim.robot import HOME_QPOS
 from vcage.skills.base import (
     APPROACH,
@@ -156,7 +156,7 @@ def _across_drawer(s: Skills, obj: str, target: str, placement: str | None, offs
     surface, host_yaw = placement_target(s, target, placement)
     sx, sy = CATALOG.get(s.world.object(obj).type_name).size[:2]
     long_axis = yaw_of(s.world.object_mat(obj)) + (0.0 if sx >= sy else math.pi / 2)
-    turn = wrap_angle(2 * wrap_angle(host_yaw + math.pi / 2 - long_axis)) / 2  # the drawer slides along x
+    turn = wrap_half_turn(host_yaw + math.pi / 2 - long_axis)  # the drawer slides along its x
     _, hand_yaw = s.tcp()
     return _lower_and_release(s, surface, rot_z(turn) @ offset, hand_yaw + turn, PLACE_CLEARANCE)
 

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from typing import Any, ClassVar
 
-from vcage.geometry import wrap_angle, yaw_of
+from vcage.geometry import wrap_half_turn, yaw_of
 from vcage.planning.schema import Predicate
 from vcage.sim.world import World
 from vcage.skills.base import Skills
@@ -23,8 +23,7 @@ def heading(world: World, obj: str) -> float:
 
 def turn_to_align(world: World, obj: str, host: str) -> float:
     """The smallest turn (within ±pi/2) that lines ``obj`` up with ``host``'s axes (mod pi)."""
-    d = wrap_angle(heading(world, host) - heading(world, obj))
-    return wrap_angle(2 * d) / 2
+    return wrap_half_turn(heading(world, host) - heading(world, obj))
 
 
 class PlaceTask(AtomicTask):
