@@ -21,8 +21,12 @@ from vcage.tasks.predicates import ORACLE_CHECKS
 PRESSED = Predicate(name="pressed", args=("bell",))
 
 
+def _composed(*objects: ObjectSpec) -> World:
+    return compose(SceneSpec(objects=objects)).make_world()
+
+
 def _settled(*objects: ObjectSpec) -> World:
-    world = compose(SceneSpec(objects=objects)).make_world()
+    world = _composed(*objects)
     world.settle(0.5)
     return world
 
@@ -72,17 +76,63 @@ def test_inside_needs_the_region_and_the_height_below_the_rim() -> None:
     inside = _settled(ObjectSpec("bread", "bread", (0.5, 0.1), z=0.78),
                       ObjectSpec("basket", "basket", (0.5, 0.1)))
     assert _value(inside, "inside", "bread", "basket")
-    above = compose(SceneSpec(objects=(ObjectSpec("bread", "bread", (0.5, 0.1), z=0.95),
-                                       ObjectSpec("basket", "basket", (0.5, 0.1))))).make_world()
+    above = _composed(ObjectSpec("bread", "bread", (0.5, 0.1), z=0.95),
+                      ObjectSpec("basket", "basket", (0.5, 0.1)))
     above.forward()  # held over the basket, in its region but above the rim
     assert not _value(above, "inside", "bread", "basket")
+
+
+def _posed(world: World, name: str, pose: list[float]) -> None:
+    """Put ``name``'s free joint at ``pose`` (x, y, height above the table top, quaternion)."""
+    adr = int(world.model.jnt_qposadr[world.model.joint(f"{name}/free").id])
+    world.data.qpos[adr:adr + 7] = [pose[0], pose[1], world.table_top() + pose[2], *pose[3:]]
+
+
+def test_a_loaf_wedged_under_a_tipped_baskets_edge_is_not_inside_it() -> None:
+    """The poses of a loaf and a basket after a Vanilla rollout (prepare_breakfast, episode 12): the
+    loaf lies against the basket's outer wall, under its raised edge. Its origin (the centre of its
+    base) lies within a centimetre of the basket's region and level with its floor, which the
+    oracle once took for inside."""
+    world = _composed(ObjectSpec("bread", "bread", (0.2, 0.3), scale=0.9506),
+                      ObjectSpec("basket", "basket", (0.5, 0.1), scale=1.0231))
+    _posed(world, "bread", [0.5842, -0.2663, 0.0127, 0.3706, 0.0692, -0.059, 0.9243])
+    _posed(world, "basket", [0.5484, -0.1746, 0.0138, 0.5757, -0.0575, 0.0415, 0.8146])
+    world.forward()
+    assert not _value(world, "inside", "bread", "basket")
+
+
+def test_a_loaf_standing_on_end_in_a_basket_is_inside_it() -> None:
+    """A loaf upended in a basket has its origin (the centre of its base, now a side) above the rim;
+    its lowest point lies on the floor and its centre of mass within the walls."""
+    on_end = [np.cos(np.pi / 4), 0.0, np.sin(np.pi / 4), 0.0]  # 90 degrees about y: long axis up
+    world = _composed(ObjectSpec("bread", "bread", (0.2, 0.3)),
+                      ObjectSpec("basket", "basket", (0.5, 0.1)))
+    _posed(world, "bread", [0.5 - 0.034, 0.1, 0.08, *on_end])
+    world.forward()
+    world.settle(0.5)
+    assert world.object_pos("bread")[2] - world.table_top() > 0.06  # the origin stands above the rim
+    assert _value(world, "inside", "bread", "basket")
+
+
+def test_the_lowest_point_of_an_object_is_where_it_meets_the_table() -> None:
+    """:meth:`World.object_lowest` for boxes, capsules, cylinders and spheres, upright or tipped."""
+    world = _settled(ObjectSpec("block", "block", (0.5, -0.15)), ObjectSpec("bread", "bread", (0.5, 0.1)),
+                     ObjectSpec("can", "can", (0.65, -0.1)), ObjectSpec("mouse", "mouse", (0.4, 0.25)),
+                     ObjectSpec("ball", "tennis_ball", (0.35, -0.2)))
+    up, origin = np.array([0.0, 0.0, 1.0]), np.array([0.0, 0.0, world.table_top()])
+    for name in ("block", "bread", "can", "mouse", "ball"):
+        assert abs(world.object_lowest(name, up, origin)) < 0.002, name
+    _posed(world, "can", [0.65, -0.1, 0.2, np.cos(0.6), np.sin(0.6), 0.0, 0.0])  # tipped and lifted
+    world.forward()
+    world.settle(1.0)  # falls and lies on its side, then rolls still
+    assert abs(world.object_lowest("can", up, origin)) < 0.002
 
 
 def test_on_a_tipped_block_is_not_beside_it() -> None:
     """A block knocked onto its side has its placement frame beside it: a block lying there is not on
     it (seen in a Vanilla rollout, where the oracle called two blocks side by side a tower)."""
-    world = compose(SceneSpec(objects=(ObjectSpec("base", "block", (0.55, 0.0)),
-                                       ObjectSpec("middle", "block", (0.55, 0.1))))).make_world()
+    world = _composed(ObjectSpec("base", "block", (0.55, 0.0)),
+                      ObjectSpec("middle", "block", (0.55, 0.1)))
     half, turn = 0.0225, [np.cos(-np.pi / 4), np.sin(-np.pi / 4), 0.0, 0.0]  # 90 degrees about x
     for name, y in (("base", -half), ("middle", half + 0.002)):  # both on their sides, side by side
         adr = int(world.model.jnt_qposadr[world.model.joint(f"{name}/free").id])

@@ -195,6 +195,41 @@ class World:
     def object_mat(self, name: str) -> np.ndarray:
         return self.data.xmat[self.object(name).body_id].reshape(3, 3).copy()
 
+    def object_com(self, name: str) -> np.ndarray:
+        """Centre of mass of ``name``'s bodies (its root and everything attached to it)."""
+        return self.data.subtree_com[self.object(name).body_id].copy()
+
+    def object_lowest(self, name: str, up: np.ndarray, origin: np.ndarray) -> float:
+        """Height along the unit vector ``up``, from ``origin``, of the lowest point of ``name``'s
+        collision geoms: each box, sphere, capsule or cylinder's support point against ``-up``."""
+        geoms = self._collision_geoms(name)
+        m, d = self.model, self.data
+        up = np.asarray(up, dtype=float)
+        low = np.inf
+        for g in geoms:
+            c, rot, size = d.geom_xpos[g] - origin, d.geom_xmat[g].reshape(3, 3), m.geom_size[g]
+            n = rot.T @ up  # ``up`` in the geom's frame
+            gtype = int(m.geom_type[g])
+            if gtype == mujoco.mjtGeom.mjGEOM_BOX:
+                depth = -float(np.abs(n) @ size)
+            elif gtype == mujoco.mjtGeom.mjGEOM_SPHERE:
+                depth = -float(size[0])
+            elif gtype == mujoco.mjtGeom.mjGEOM_CAPSULE:
+                depth = -float(abs(n[2]) * size[1] + size[0])
+            elif gtype == mujoco.mjtGeom.mjGEOM_CYLINDER:
+                depth = -float(abs(n[2]) * size[1] + size[0] * np.sqrt(max(0.0, 1.0 - n[2] ** 2)))
+            else:  # no catalog object has other shapes: their bounding sphere, which reaches lower
+                depth = -float(m.geom_rbound[g])
+            low = min(low, float(c @ up) + depth)
+        return low
+
+    def _collision_geoms(self, name: str) -> np.ndarray:
+        """Ids of ``name``'s geoms that take part in contacts (not its decorations)."""
+        idx = self.object_names.index(name)
+        ids = np.arange(self.model.ngeom)
+        solid = (self.model.geom_contype != 0) | (self.model.geom_conaffinity != 0)
+        return ids[(self.object_of_geom(ids) == idx) & solid]
+
     def object_of_geom(self, geom_ids: np.ndarray) -> np.ndarray:
         """Index into :attr:`object_names` of each geom's object, or -1 for non-objects."""
         roots = self.model.body_rootid[self.model.geom_bodyid[geom_ids]]

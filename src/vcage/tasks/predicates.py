@@ -22,6 +22,7 @@ XY_TOL = 0.01  # slack beyond a placement region's edge
 Z_TOL = 0.02  # how far above a surface an object may rest and still be "on" it
 SURFACE_TILT = np.pi / 4  # radians a placement surface may tilt and still hold what rests on it
 SHUT_TOL = 0.01  # metres a drawer may stand out and still count as shut
+FLOOR_TOL = 0.005  # metres an object's lowest point may lie below a container's floor (contact depth)
 
 
 def _region(world: World, target: str,
@@ -36,9 +37,9 @@ def _region(world: World, target: str,
     return center, rot, np.asarray(place.half_size) * inst.scale, place.wall_height * inst.scale
 
 
-def _in_region(world: World, obj: str, center: np.ndarray, rot: np.ndarray, half: np.ndarray,
+def _in_region(point: np.ndarray, center: np.ndarray, rot: np.ndarray, half: np.ndarray,
                tol: float = XY_TOL) -> bool:
-    local = rot.T @ (world.object_pos(obj) - center)
+    local = rot.T @ (point - center)
     return bool(np.all(np.abs(local[:2]) <= half + tol))
 
 
@@ -59,15 +60,23 @@ def on(world: World, obj: str, target: str, placement: str | None = None) -> boo
     it, where an object standing next to a tipped block would count as on it)."""
     center, rot, half, _ = _region(world, target, placement)
     dz = world.object_pos(obj)[2] - center[2]
-    return _faces_up(rot) and -0.01 <= dz <= Z_TOL and _in_region(world, obj, center, rot, half)
+    return _faces_up(rot) and -0.01 <= dz <= Z_TOL and _in_region(world.object_pos(obj), center, rot, half)
 
 
 def inside(world: World, obj: str, container: str, placement: str | None = None) -> bool:
-    """``obj``'s origin is within the container's region and below its rim; the container's opening
-    faces up."""
+    """``obj`` lies in the container: its centre of mass is over the region, within the walls, and
+    its lowest point lies between the floor and the rim; the container's opening faces up. Heights
+    and the region are taken in the container's frame, so they tip with it.
+
+    Not ``obj``'s origin (the centre of its base), which says little once ``obj`` tilts: a loaf
+    standing on end in a basket has it above the rim, and one wedged under a tipped basket's raised
+    edge, outside the wall, has it within a centimetre of the region.
+    """
     center, rot, half, wall = _region(world, container, placement)
-    dz = world.object_pos(obj)[2] - center[2]
-    return _faces_up(rot) and -0.01 <= dz <= max(wall, Z_TOL) and _in_region(world, obj, center, rot, half)
+    com = rot.T @ (world.object_com(obj) - center)
+    low = world.object_lowest(obj, rot[:, 2], center)
+    return (_faces_up(rot) and bool(np.all(np.abs(com[:2]) <= half))
+            and -FLOOR_TOL <= low <= max(wall, Z_TOL))
 
 
 def _faces_up(rot: np.ndarray) -> bool:
