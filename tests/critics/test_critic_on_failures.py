@@ -143,21 +143,35 @@ def test_an_object_put_down_on_clutter_that_lies_on_its_target_is_not_on_it() ->
     assert "mouse lies over block" in verdict.reason
 
 
-def _mouse_set_on_the_pad(quat: tuple[float, float, float, float], z: float) -> Verdict:
-    """The critic's verdict on a mouse put on the pad as planned, with the "after" views replaced by
-    the same pad with the mouse dropped from ``z`` in orientation ``quat`` and settled (no injected
-    fault leaves a mouse in such a pose reliably); the oracle must say it is not on the pad."""
-    done = run(MOUSE_PAD, put_on("mouse", "pad", "the mouse is on the pad"))
+def _set_down(scene: tuple[O, ...], subtask: Subtask, placed: O, quat: tuple[float, float, float, float],
+              extra: tuple[O, ...] = ()) -> tuple[bool, Verdict]:
+    """The oracle's and the critic's verdicts on ``subtask`` done as planned in ``scene``, with the
+    "after" views replaced by the same scene (and the objects ``extra``, unlabelled) with ``placed``
+    dropped from its ``z`` in orientation ``quat`` and settled (no injected fault leaves an object
+    in such a pose reliably)."""
+    done = run(scene, subtask)
     assert done.success and CRITIC.judge(done.obs).accept
-    world = compose(SceneSpec(objects=(O("mouse", "mouse", (0.55, 0.12), z=z), MOUSE_PAD[1]))).make_world()
-    adr = world.model.jnt_qposadr[world.model.body_jntadr[world.object("mouse").body_id]]
+    others = tuple(o for o in scene if o.name != placed.name)
+    assert scene[0].name == placed.name  # the segmentation labels keep their order
+    world = compose(SceneSpec(objects=(placed, *others, *extra))).make_world()
+    adr = world.model.jnt_qposadr[world.model.body_jntadr[world.object(placed.name).body_id]]
     world.data.qpos[adr + 3:adr + 7] = quat
     world.forward()
     world.settle(1.0)
-    assert not P.on(world, "mouse", "pad")
     with Renderer(world, 320, 240) as renderer:
         after = render_views(renderer)
-    return CRITIC.judge(replace(done.obs, after=after))
+    placing = [p for p in subtask.predicates if p.name != "released"]
+    oracle = all(P.ORACLE_CHECKS.get(p.name)(world, *p.args) for p in placing)
+    return oracle, CRITIC.judge(replace(done.obs, after=after))
+
+
+def _mouse_set_on_the_pad(quat: tuple[float, float, float, float], z: float) -> Verdict:
+    """A mouse put on the pad, replaced by one settled in orientation ``quat``; the oracle must say
+    it is not on the pad."""
+    oracle, verdict = _set_down(MOUSE_PAD, put_on("mouse", "pad", "the mouse is on the pad"),
+                                O("mouse", "mouse", (0.55, 0.12), z=z), quat)
+    assert not oracle
+    return verdict
 
 
 def test_a_mouse_on_its_back_on_the_pad_is_not_on_it() -> None:
@@ -174,6 +188,40 @@ def test_a_mouse_standing_on_its_end_on_the_pad_is_not_on_it() -> None:
     verdict = _mouse_set_on_the_pad((np.cos(np.pi / 4), 0.0, np.sin(np.pi / 4), 0.0), 0.85)  # about y
     assert not verdict.accept and "higher than mouse standing on pad's surface reaches" in verdict.reason, \
         verdict.reason
+
+
+def test_a_loaf_upside_down_in_the_basket_is_inside_it() -> None:
+    """A Vanilla rollout left a loaf standing on its end in the basket: inside it for the oracle, but
+    its top, a flat end where the crust had been curved, was read as turned over. On a surface that
+    means it does not rest on its base; in a container an object may lie any way up. Upside down,
+    its flat underside shows from the top."""
+    oracle, verdict = _set_down(BREAD_BASKET, put_in("bread", "basket", "the bread is in the basket"),
+                                O("bread", "bread", (0.58, 0.12), z=0.8), (0.0, 1.0, 0.0, 0.0))
+    assert oracle
+    assert verdict.accept, verdict.reason
+
+
+def test_a_loaf_standing_on_end_in_the_basket_is_inside_it() -> None:
+    """A Vanilla rollout left a loaf (at a large scale, in a small basket) standing on its end in the
+    basket. Its top stood higher above the rim than the loaf lying down is tall; in a container its
+    longest side bounds that, once its top view shows it turned."""
+    loaf = O("bread", "bread", (0.5, -0.12), scale=1.1)
+    basket = O("basket", "basket", (0.58, 0.12), scale=0.9)
+    oracle, verdict = _set_down((loaf, basket), put_in("bread", "basket", "the bread is in the basket"),
+                                replace(loaf, xy=(0.58 - 0.034, 0.12), z=0.83),
+                                (np.cos(np.pi / 4), 0.0, np.sin(np.pi / 4), 0.0))  # long axis up
+    assert oracle
+    assert verdict.accept, verdict.reason
+
+
+def test_a_loaf_lying_on_a_cup_above_the_rim_is_not_inside_the_basket() -> None:
+    """A Vanilla rollout left a loaf lying flat on a cup that stood in the basket, all of it above the
+    rim. It lies as it did on the table, so its height, not its longest side, bounds its top."""
+    cup = O("cup", "cup", (0.58, 0.12), z=0.735)  # on the basket's floor
+    oracle, verdict = _set_down(BREAD_BASKET, put_in("bread", "basket", "the bread is in the basket"),
+                                O("bread", "bread", (0.58, 0.12), z=0.9), (1.0, 0.0, 0.0, 0.0), extra=(cup,))
+    assert not oracle
+    assert not verdict.accept and "higher than" in verdict.reason, verdict.reason
 
 
 def test_a_block_put_down_where_another_stands_is_not_on_the_table() -> None:

@@ -206,7 +206,8 @@ def _rests_on(obs: Observation, a: str, b: str, inside: bool) -> tuple[bool, str
         return False, f"only {overlap:.0%} of {a} overlaps {b} from the top"
     if not centroid_in(ma, mb, CENTRE_TOL):
         return False, f"the centre of {a} is not over {b} from the top"
-    other = _landed_on_other(obs, top, a, b, inside) or _turned_over(obs, top, a)
+    # in a container an object may lie any way up; on a surface, turned over it does not rest on its base
+    other = _landed_on_other(obs, top, a, b, inside) or (None if inside else _turned_over(obs, top, a))
     if other is not None:
         return False, other
     fa, fb = rows_of(_mask(obs, front, a)), rows_of(_mask(obs, front, b) | _mask(obs, front, a))
@@ -224,7 +225,9 @@ def _landed_on_other(obs: Observation, top: View, a: str, b: str, inside: bool) 
 
     - ``a`` stands too high: an object resting on ``b`` has the top of its own axis (whose height
       its lowest pixel cannot exceed) at most its height above its resting face, which lies on
-      ``b``'s surface (for ``inside``, at most at ``b``'s rim).
+      ``b``'s surface. In ``b`` it may lie any way up (the oracle asks only that its lowest point be
+      below the rim): where its top-view area changed as a turned object's does (see
+      :data:`AREA_RATIO`), its longest side takes the place of its height above the rim.
     - ``a`` lies over another object ``c`` whose top stood more than :data:`SUPPORT_TOL` above that
       surface: before the subtask the top view showed ``c`` where ``a`` is seen now, and ``c`` is
       still there (followed if it was pushed), so ``a`` lies above ``c`` and cannot be down on ``b``.
@@ -240,24 +243,27 @@ def _landed_on_other(obs: Observation, top: View, a: str, b: str, inside: bool) 
     surface = rim if inside else _surface(obs, b, rim)
     btype = _type_of(obs, b)
     leans = btype is not None and bool(btype.placements) and btype.placements[0].slope > 0
+    was, now = int(_mask(obs, before, a).sum()), int(_mask(obs, top, a).sum())
+    turned = was > 0 and not AREA_RATIO[0] <= now / was <= AREA_RATIO[1]
     return _not_down(obs, top, a, surface, rim, f"{b}'s {'rim' if inside else 'surface'}", (a, b),
-                     standing=not leans)
+                     standing=not leans, any_way_up=inside and turned)
 
 
 def _not_down(obs: Observation, top: View, a: str, surface: float | None, floor: float, where: str,
-              skip: tuple[str, ...], standing: bool = False) -> str | None:
+              skip: tuple[str, ...], standing: bool = False, any_way_up: bool = False) -> str | None:
     """Why ``a`` cannot rest on a support whose surface lies ``surface`` above the table (``where``
     names it), from the top view's heights; None if they allow it (or cannot tell). Without a known
     surface only clutter higher than ``floor`` counts (see :func:`_landed_on_other`). ``standing``:
     ``a`` stands there as it stood before (put down by the hand, on a surface that does not lean), so
     its top can be no higher than its type's height above the surface either (tipped onto a side, or
-    propped on something, it stands taller)."""
+    propped on something, it stands taller). ``any_way_up``: ``a`` may rest on any face (in a
+    container), so its longest side bounds how far its top stands above the surface."""
     before = obs.before.get(TOP)
     hb, ha = (_heights(before), _heights(top)) if before is not None else (None, None)
     ma = _mask(obs, top, a)
     if before is None or hb is None or ha is None or not ma.any():
         return None
-    height = _max_height(obs, a)
+    height = _max_height(obs, a, any_way_up)
     too_tall = None  # said after the clutter under ``a``, which says more
     if surface is not None and height is not None:
         above = float(ha[ma].min()) - height - surface
@@ -328,10 +334,13 @@ def _surface(obs: Observation, b: str, top: float) -> float | None:
     return top - (otype.size[2] - otype.placements[0].pos[2]) * otype.scale_range[0]
 
 
-def _max_height(obs: Observation, a: str) -> float | None:
-    """``a``'s height above its resting face at the largest scale of its type."""
+def _max_height(obs: Observation, a: str, any_way_up: bool = False) -> float | None:
+    """``a``'s height above its resting face at the largest scale of its type (``any_way_up``: above
+    whichever face it rests on, its longest side)."""
     otype = _type_of(obs, a)
-    return otype.size[2] * otype.scale_range[1] if otype is not None else None
+    if otype is None:
+        return None
+    return (max(otype.size) if any_way_up else otype.size[2]) * otype.scale_range[1]
 
 
 def _covered(obs: Observation, top: View, b: str) -> bool:
