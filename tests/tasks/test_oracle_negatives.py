@@ -129,8 +129,8 @@ def test_the_lowest_point_of_an_object_is_where_it_meets_the_table() -> None:
 
 
 def test_on_a_tipped_block_is_not_beside_it() -> None:
-    """A block knocked onto its side has its placement frame beside it: a block lying there is not on
-    it (seen in a Vanilla rollout, where the oracle called two blocks side by side a tower)."""
+    """Two blocks knocked onto their sides, side by side, are not a tower (seen in a Vanilla rollout,
+    where the oracle once took the placement frame of a block on its side, which lay beside it)."""
     world = _composed(ObjectSpec("base", "block", (0.55, 0.0)),
                       ObjectSpec("middle", "block", (0.55, 0.1)))
     half, turn = 0.0225, [np.cos(-np.pi / 4), np.sin(-np.pi / 4), 0.0, 0.0]  # 90 degrees about x
@@ -144,6 +144,21 @@ def test_on_a_tipped_block_is_not_beside_it() -> None:
     tower = _settled(ObjectSpec("base", "block", (0.55, 0.0)),
                      ObjectSpec("middle", "block", (0.55, 0.0), z=0.79))
     assert _value(tower, "on", "middle", "base")
+
+
+def test_a_block_on_a_block_lying_on_its_side_is_on_it() -> None:
+    """A cube's faces are all alike: a Vanilla rollout stacked a block on a middle block that had
+    turned onto its side on the base, a tower of three that the oracle once denied."""
+    world = _settled(ObjectSpec("base", "block", (0.55, 0.0)), ObjectSpec("middle", "block", (0.3, 0.2)),
+                     ObjectSpec("top", "block", (0.55, 0.0), z=0.95))
+    half, turn = 0.0225, np.array([np.cos(-np.pi / 4), np.sin(-np.pi / 4), 0.0, 0.0])  # 90 degrees about x
+    _posed(world, "middle", [0.55, -half, 3 * half + 0.001, *turn])  # its origin (base's centre) at the side
+    _posed(world, "top", [0.555, 0.0, 4 * half + 0.002, 1.0, 0.0, 0.0, 0.0])
+    world.forward()
+    world.settle(0.5)
+    assert abs(world.object_mat("middle")[2, 2]) < 0.1  # on its side
+    assert _value(world, "on", "top", "middle") and _value(world, "stacked", "base", "middle", "top")
+    assert not _value(world, "on", "top", "base")
 
 
 def test_released_is_false_while_the_hand_holds_the_object() -> None:

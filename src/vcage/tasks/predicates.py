@@ -28,12 +28,21 @@ FLOOR_TOL = 0.005  # metres an object's lowest point may lie below a container's
 def _region(world: World, target: str,
             placement: str | None) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
     """Centre (world), rotation, half size and wall height of ``target``'s placement region, where
-    it is now (a drawer's inside comes out with the drawer)."""
+    it is now (a drawer's inside comes out with the drawer, a cube's is the face that is up)."""
     inst = world.object(target)
-    place = CATALOG.get(inst.type_name).placement(placement)
+    otype = CATALOG.get(inst.type_name)
+    place = otype.placement(placement)
     rot = world.object_mat(target)
     local = np.asarray(place.pos) * inst.scale + slid(world, target, place.joint)
     center = world.object_pos(target) + rot @ local
+    if otype.any_face:  # the face up now: the cube's centre plus half a side along the axis nearest up
+        side = place.pos[2] * inst.scale
+        middle = center - rot[:, 2] * side / 2
+        k = int(np.argmax(np.abs(rot[2])))
+        up = rot[:, k] * np.sign(rot[2, k])
+        x = rot[:, (k + 1) % 3]
+        rot = np.column_stack([x, np.cross(up, x), up])
+        center = middle + up * side / 2
     return center, rot, np.asarray(place.half_size) * inst.scale, place.wall_height * inst.scale
 
 
@@ -55,12 +64,17 @@ def contact_between(world: World, a: str, b: str) -> bool:
 
 
 def on(world: World, obj: str, target: str, placement: str | None = None) -> bool:
-    """``obj`` rests on ``target``'s placement surface, within its region; the surface faces up
+    """``obj`` rests on ``target``'s placement surface, within its region, and the surface faces up
     (a target tipped over has no placement surface to rest on: the region's frame would lie beside
-    it, where an object standing next to a tipped block would count as on it)."""
+    it, where an object standing next to a tipped target would count as on it; a cube's surface is
+    the face that is up). ``obj`` rests on its base, its origin (the base's centre) on the surface;
+    a cube (``any_face``) on whichever face is down: its lowest point and its centre count."""
     center, rot, half, _ = _region(world, target, placement)
-    dz = world.object_pos(obj)[2] - center[2]
-    return _faces_up(rot) and -0.01 <= dz <= Z_TOL and _in_region(world.object_pos(obj), center, rot, half)
+    if CATALOG.get(world.object(obj).type_name).any_face:
+        dz, point = world.object_lowest(obj, rot[:, 2], center), world.object_com(obj)
+    else:
+        dz, point = world.object_pos(obj)[2] - center[2], world.object_pos(obj)
+    return _faces_up(rot) and -0.01 <= dz <= Z_TOL and _in_region(point, center, rot, half)
 
 
 def inside(world: World, obj: str, container: str, placement: str | None = None) -> bool:

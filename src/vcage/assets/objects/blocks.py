@@ -26,7 +26,7 @@ def _cube(p: PartBuilder) -> None:
 CATALOG.add_type(ObjectType(
     name="block", category="toy", description="a small wooden cube block",
     size=(BLOCK, BLOCK, BLOCK), mass=0.06, colors=BLOCK_COLORS, build=_cube,
-    tags=frozenset({"block", "stackable", "graspable", "colored"}), scale_range=(0.95, 1.05),
+    tags=frozenset({"block", "stackable", "graspable", "colored"}), scale_range=(0.95, 1.05), any_face=True,
     annotations=Annotations(
         grasps=tuple(Grasp(f"top_{i}", (0, 0, BLOCK / 2), yaw=i * math.pi / 2, width=BLOCK)
                      for i in range(2)),
