@@ -202,7 +202,8 @@ def _rests_on(obs: Observation, a: str, b: str, inside: bool) -> tuple[bool, str
         return False, f"{b} is not visible from the top"
     small, big = (ma, mb) if ma.sum() <= mb.sum() else (mb, ma)
     overlap = float((small & hull(big)).sum() / small.sum())
-    if overlap < MIN_OVERLAP:
+    btype = _type_of(obs, b)
+    if overlap < MIN_OVERLAP and not (btype is not None and btype.any_face):
         return False, f"only {overlap:.0%} of {a} overlaps {b} from the top"
     if not centroid_in(ma, mb, CENTRE_TOL):
         return False, f"the centre of {a} is not over {b} from the top"
