@@ -7,15 +7,18 @@ lowest in the subtask's own motion, not in what ran after it) and after the retr
 simulator state. Each predicate is checked in image space:
 
 - ``on(a, b)`` / ``inside(a, b)``: in the top view most of ``a``'s pixels lie in the convex hull of
-  ``b``'s outline (or, when ``a`` is the larger, ``b``'s in ``a``'s) and ``a``'s centre lies over
-  it; ``b``'s outline is its visible pixels plus its outline from before, moved to where it is now
-  (``a`` may hide ``b``, and both may have moved). In the front view ``a`` rests on ``b``: its
+  ``b``'s outline (or, when ``a`` is the larger, ``b``'s in ``a``'s; on a cube, whose surface is its
+  whole face, only the centre counts) and ``a``'s centre lies over it; ``b``'s outline is its
+  visible pixels plus its outline from before, moved to where it is now (``a`` may hide ``b``, and
+  both may have moved). In the front view ``a`` rests on ``b``: its
   lowest pixel row lies within ``b``'s rows (for ``inside``, no lower than ``b``'s bottom). With the
   top view's depth, ``a`` is down on ``b``: its lowest point is no higher than its type's height
   above ``b``'s surface (for ``inside``, its rim), and it does not lie over another object that
   stood higher than that surface before the subtask (clutter on the target); an object that stood on
-  its base with a curved top before and shows a flat one now lies turned over. Put down on a surface
-  that does not lean, ``a``'s top stands no higher than its type's height above that surface. In a
+  its base with a curved top before and shows a flat one now lies turned over (not asked in a
+  container, where it may lie any way up). Put down on a surface that does not lean, ``a``'s top
+  stands no higher than its type's height above that surface (in a container, where its top view
+  shows it turned, its longest side above the rim). In a
   drawer (a placement that comes out with a joint) the drawer is still open after the subtask, and
   ``a`` lies over what came out of ``b`` (not on its body), below the drawer's rim, and no lower
   than lying on the drawer's floor makes it.
