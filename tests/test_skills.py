@@ -118,3 +118,22 @@ def test_what_is_put_into_a_drawer_lies_across_it_so_the_drawer_shuts() -> None:
     assert P.closed(world, "cab") and P.inside(world, "sponge", "cab")
     with pytest.raises(SkillError, match="'sponge' \\(sponge\\) has no drawer handle"):
         skills.do("open_drawer", obj="sponge")
+
+
+def test_a_block_is_put_on_the_face_a_tipped_block_turns_up() -> None:
+    """The skills aim at the placement region the oracle judges: a block knocked onto its side
+    carries what is put on the face that is up now, not on a frame beside it."""
+    from vcage.scene.compose import compose
+    from vcage.scene.spec import ObjectSpec, SceneSpec
+
+    world = compose(SceneSpec(objects=(ObjectSpec("a", "block", (0.5, -0.12)),
+                                       ObjectSpec("b", "block", (0.55, 0.1))))).make_world()
+    adr = int(world.model.jnt_qposadr[world.model.joint("b/free").id])
+    half, turn = 0.0225, [np.cos(np.pi / 4), np.sin(np.pi / 4), 0.0, 0.0]  # on its side: 90 degrees about x
+    world.data.qpos[adr:adr + 7] = [0.55, 0.1 + half, world.table_top() + half, *turn]
+    world.forward()
+    world.settle(0.5)
+    assert abs(world.object_mat("b")[2, 2]) < 0.1
+    Skills(world).do("pick_and_place", obj="a", target="b")
+    world.settle(0.5)
+    assert P.on(world, "a", "b")

@@ -25,9 +25,9 @@ from vcage.skills.base import (
     TCP_MIN_ABOVE_TABLE,
     Skills,
 )
-from vcage.skills.drawers import slid
 from vcage.skills.ik import down_rotation
 from vcage.skills.motion import MotionPlan, Waypoint
+from vcage.skills.placements import placement_frame
 
 PLACE_CLEARANCE = 0.012  # metres above its resting height at which a placed object is let go
 
@@ -89,14 +89,10 @@ def _held_offset(s: Skills, obj: str) -> np.ndarray:
 
 
 def placement_target(s: Skills, target: str, placement: str | None = None) -> tuple[np.ndarray, float]:
-    """World position (surface height) and yaw of ``target``'s placement annotation (where it is
-    now: a drawer's inside comes out with the drawer)."""
-    inst = s.world.object(target)
-    otype = CATALOG.get(inst.type_name)
-    place = otype.placement(placement)
-    pos, rot = s.world.object_pos(target), s.world.object_mat(target)
-    local = np.asarray(place.pos) * inst.scale + slid(s.world, target, place.joint)
-    return pos + rot @ local, yaw_of(rot)
+    """World position (surface height) and yaw of ``target``'s placement region where it is now
+    (:func:`~vcage.skills.placements.placement_frame`)."""
+    center, rot, _, _ = placement_frame(s.world, target, placement)
+    return center, yaw_of(rot)
 
 
 @SKILLS.register("place")

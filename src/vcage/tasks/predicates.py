@@ -16,34 +16,14 @@ from vcage.geometry import tilt_of
 from vcage.registry import Registry
 from vcage.scene.spec import ROBOT_MOUNT
 from vcage.sim.world import World
-from vcage.skills.drawers import opening, slid
+from vcage.skills.drawers import opening
+from vcage.skills.placements import placement_frame
 
 XY_TOL = 0.01  # slack beyond a placement region's edge
 Z_TOL = 0.02  # how far above a surface an object may rest and still be "on" it
 SURFACE_TILT = np.pi / 4  # radians a placement surface may tilt and still hold what rests on it
 SHUT_TOL = 0.01  # metres a drawer may stand out and still count as shut
 FLOOR_TOL = 0.005  # metres an object's lowest point may lie below a container's floor (contact depth)
-
-
-def _region(world: World, target: str,
-            placement: str | None) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
-    """Centre (world), rotation, half size and wall height of ``target``'s placement region, where
-    it is now (a drawer's inside comes out with the drawer, a cube's is the face that is up)."""
-    inst = world.object(target)
-    otype = CATALOG.get(inst.type_name)
-    place = otype.placement(placement)
-    rot = world.object_mat(target)
-    local = np.asarray(place.pos) * inst.scale + slid(world, target, place.joint)
-    center = world.object_pos(target) + rot @ local
-    if otype.any_face:  # the face up now: the cube's centre plus half a side along the axis nearest up
-        side = place.pos[2] * inst.scale
-        middle = center - rot[:, 2] * side / 2
-        k = int(np.argmax(np.abs(rot[2])))
-        up = rot[:, k] * np.sign(rot[2, k])
-        x = rot[:, (k + 1) % 3]
-        rot = np.column_stack([x, np.cross(up, x), up])
-        center = middle + up * side / 2
-    return center, rot, np.asarray(place.half_size) * inst.scale, place.wall_height * inst.scale
 
 
 def _in_region(point: np.ndarray, center: np.ndarray, rot: np.ndarray, half: np.ndarray,
@@ -69,7 +49,7 @@ def on(world: World, obj: str, target: str, placement: str | None = None) -> boo
     it, where an object standing next to a tipped target would count as on it; a cube's surface is
     the face that is up). ``obj`` rests on its base, its origin (the base's centre) on the surface;
     a cube (``any_face``) on whichever face is down: its lowest point and its centre count."""
-    center, rot, half, _ = _region(world, target, placement)
+    center, rot, half, _ = placement_frame(world, target, placement)
     if CATALOG.get(world.object(obj).type_name).any_face:
         dz, point = world.object_lowest(obj, rot[:, 2], center), world.object_com(obj)
     else:
@@ -86,7 +66,7 @@ def inside(world: World, obj: str, container: str, placement: str | None = None)
     standing on end in a basket has it above the rim, and one wedged under a tipped basket's raised
     edge, outside the wall, has it within a centimetre of the region.
     """
-    center, rot, half, wall = _region(world, container, placement)
+    center, rot, half, wall = placement_frame(world, container, placement)
     com = rot.T @ (world.object_com(obj) - center)
     low = world.object_lowest(obj, rot[:, 2], center)
     return (_faces_up(rot) and bool(np.all(np.abs(com[:2]) <= half))
