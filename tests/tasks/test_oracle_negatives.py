@@ -15,6 +15,7 @@ from vcage.scene.spec import ObjectSpec, SceneSpec
 from vcage.sim.world import World
 from vcage.skills.base import Skills
 from vcage.skills.faults import FaultConfig, FaultInjector
+from vcage.skills.placements import placement_frame
 from vcage.tasks.oracle import Oracle
 from vcage.tasks.predicates import ORACLE_CHECKS
 
@@ -112,6 +113,16 @@ def test_a_loaf_standing_on_end_in_a_basket_is_inside_it() -> None:
     world.settle(0.5)
     assert world.object_pos("bread")[2] - world.table_top() > 0.06  # the origin stands above the rim
     assert _value(world, "inside", "bread", "basket")
+
+
+def test_a_loaf_lying_across_a_cups_rim_is_not_inside_it() -> None:
+    """Its centre of mass is over the cup's opening and its lowest point at the rim's height: lying
+    on the rim is not lying in the cup (injected faults left a soap and a sponge so on a drawer's
+    front wall, the lowest-point rule without the rim's contact tolerance took them for inside)."""
+    world = _settled(ObjectSpec("cup", "cup", (0.5, 0.1)), ObjectSpec("bread", "bread", (0.5, 0.1), z=0.85))
+    center, rot, _, wall = placement_frame(world, "cup")
+    assert abs(world.object_lowest("bread", rot[:, 2], center) - wall) < 0.002  # it rests on the rim
+    assert not _value(world, "inside", "bread", "cup")
 
 
 def test_the_lowest_point_of_an_object_is_where_it_meets_the_table() -> None:

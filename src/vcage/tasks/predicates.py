@@ -23,7 +23,7 @@ XY_TOL = 0.01  # slack beyond a placement region's edge
 Z_TOL = 0.02  # how far above a surface an object may rest and still be "on" it
 SURFACE_TILT = np.pi / 4  # radians a placement surface may tilt and still hold what rests on it
 SHUT_TOL = 0.01  # metres a drawer may stand out and still count as shut
-FLOOR_TOL = 0.005  # metres an object's lowest point may lie below a container's floor (contact depth)
+CONTACT_TOL = 0.005  # metres within which an object's lowest point rests on a container's floor or rim
 
 
 def _in_region(point: np.ndarray, center: np.ndarray, rot: np.ndarray, half: np.ndarray,
@@ -59,8 +59,11 @@ def on(world: World, obj: str, target: str, placement: str | None = None) -> boo
 
 def inside(world: World, obj: str, container: str, placement: str | None = None) -> bool:
     """``obj`` lies in the container: its centre of mass is over the region, within the walls, and
-    its lowest point lies between the floor and the rim; the container's opening faces up. Heights
-    and the region are taken in the container's frame, so they tip with it.
+    its lowest point lies between the floor and the rim, at most :data:`CONTACT_TOL` below the floor
+    (pressed into it) and at least that below the rim (within it, ``obj`` rests on the rim, as a
+    soap left lying on a drawer's front wall does); the container's opening faces up. Heights and
+    the region are taken in the container's frame, so they tip with it. A container whose walls are
+    lower than :data:`Z_TOL` (a tray) holds what rests up to that high.
 
     Not ``obj``'s origin (the centre of its base), which says little once ``obj`` tilts: a loaf
     standing on end in a basket has it above the rim, and one wedged under a tipped basket's raised
@@ -70,7 +73,7 @@ def inside(world: World, obj: str, container: str, placement: str | None = None)
     com = rot.T @ (world.object_com(obj) - center)
     low = world.object_lowest(obj, rot[:, 2], center)
     return (_faces_up(rot) and bool(np.all(np.abs(com[:2]) <= half))
-            and -FLOOR_TOL <= low <= max(wall, Z_TOL))
+            and -CONTACT_TOL <= low <= max(wall - CONTACT_TOL, Z_TOL))
 
 
 def _faces_up(rot: np.ndarray) -> bool:
