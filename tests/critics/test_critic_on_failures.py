@@ -216,12 +216,27 @@ def test_a_loaf_standing_on_end_in_the_basket_is_inside_it() -> None:
 
 def test_a_loaf_lying_on_a_cup_above_the_rim_is_not_inside_the_basket() -> None:
     """A Vanilla rollout left a loaf lying flat on a cup that stood in the basket, all of it above the
-    rim. It lies as it did on the table, so its height, not its longest side, bounds its top."""
+    rim. It lies as it did on the table, so its underside is its own height under its top: above
+    the rim (and its height, not its longest side, bounds its top)."""
     cup = O("cup", "cup", (0.58, 0.12), z=0.735)  # on the basket's floor
     oracle, verdict = _set_down(BREAD_BASKET, put_in("bread", "basket", "the bread is in the basket"),
                                 O("bread", "bread", (0.58, 0.12), z=0.9), (1.0, 0.0, 0.0, 0.0), extra=(cup,))
     assert not oracle
-    assert not verdict.accept and "higher than" in verdict.reason, verdict.reason
+    assert not verdict.accept and "above basket's rim" in verdict.reason, verdict.reason
+
+
+def test_a_loaf_bridging_the_baskets_rims_is_not_inside_it() -> None:
+    """A large loaf put across a small basket can come to rest on both long rims: from the top it lies
+    over the basket, no higher than a loaf in a basket may reach, but its underside is at the rim's
+    height (the oracle: not inside). Injected faults left five such loaves in the balanced set."""
+    loaf = O("bread", "bread", (0.5, -0.12), scale=1.1)
+    basket = O("basket", "basket", (0.58, 0.12), scale=0.9)
+    across = (np.cos(np.pi / 4), 0.0, 0.0, np.sin(np.pi / 4))  # its long side along the basket's short one
+    oracle, verdict = _set_down((loaf, basket), put_in("bread", "basket", "the bread is in the basket"),
+                                replace(loaf, xy=(0.58, 0.12), z=0.83), across)
+    assert not oracle
+    assert not verdict.accept, "a loaf on the rims was accepted"
+    assert "cm under basket's rim: it rests on the rim" in verdict.reason, verdict.reason
 
 
 def test_a_block_set_diagonally_off_centre_on_a_block_is_on_it() -> None:

@@ -98,6 +98,8 @@ HEIGHT_RATIO = 0.8  # front-view height after / before for an object that stayed
 SUPPORT_TOL = 0.02
 HEIGHT_TOL = 0.01
 TOP_TOL = 0.01
+RIM_GAP = 0.003  # metres under a container's rim below which an object's underside lies in it
+RIM_PERCENTILE = 99  # of a container's top-view heights: its rim (one stray silhouette pixel is not)
 UNDER_PX = 4
 # A placed object's top keeps its shape: one whose top lay at least CURVED metres (RMS) from a plane
 # before the subtask and under FLAT_TOP of that after it shows a flat face it did not show before
@@ -249,8 +251,36 @@ def _landed_on_other(obs: Observation, top: View, a: str, b: str, inside: bool) 
     leans = btype is not None and bool(btype.placements) and btype.placements[0].slope > 0
     was, now = int(_mask(obs, before, a).sum()), int(_mask(obs, top, a).sum())
     turned = was > 0 and not AREA_RATIO[0] <= now / was <= AREA_RATIO[1]
-    return _not_down(obs, top, a, surface, rim, f"{b}'s {'rim' if inside else 'surface'}", (a, b),
-                     standing=not leans, any_way_up=inside and turned)
+    on_rim = _on_rim(obs, top, a, b) if inside and not turned else None
+    return on_rim or _not_down(obs, top, a, surface, rim, f"{b}'s {'rim' if inside else 'surface'}",
+                               (a, b), standing=not leans, any_way_up=inside and turned)
+
+
+def _on_rim(obs: Observation, top: View, a: str, b: str) -> str | None:
+    """Why ``a`` lies on ``b``'s rim rather than in it (None if it does not, or the views cannot
+    tell). ``a`` lies as it lay before (its top-view area kept), so its underside is its own height
+    under its top; before the subtask ``a`` stood on the table (the outline around it there), where
+    its top was that height. An underside less than :data:`RIM_GAP` under the rim rests on it (a
+    loaf bridging a basket), where the oracle wants it more than its contact tolerance under. The
+    rim's height is read from all of ``b``'s pixels (at the :data:`RIM_PERCENTILE`): a thin wall
+    may be one pixel wide, with no inner pixel."""
+    before = obs.before.get(TOP)
+    hb, ha = (_heights(before), _heights(top)) if before is not None else (None, None)
+    if before is None or hb is None or ha is None:
+        return None
+    was, now, mb = _mask(obs, before, a), _mask(obs, top, a), _mask(obs, before, b)
+    ring = dilate(was, 2) & ~dilate(was, 1) & (before.segmentation == -1)
+    if not was.any() or not now.any() or not mb.any():
+        return None
+    if ring.sum() < UNDER_PX or float(np.median(hb[ring])) > HEIGHT_TOL:
+        return None  # not seen standing on the table before: its own height is not known
+    rim = float(np.percentile(hb[mb], RIM_PERCENTILE))
+    own = float(np.percentile(hb[_inner(was)], 95))
+    under = rim - (float(np.percentile(ha[_inner(now)], 95)) - own)
+    if under < RIM_GAP:
+        where = f"{100 * under:.1f} cm under" if under >= 0 else f"{-100 * under:.1f} cm above"
+        return f"{a}'s underside is {where} {b}'s rim: it rests on the rim or on something, not down in {b}"
+    return None
 
 
 def _not_down(obs: Observation, top: View, a: str, surface: float | None, floor: float, where: str,
