@@ -137,3 +137,21 @@ def test_a_block_is_put_on_the_face_a_tipped_block_turns_up() -> None:
     Skills(world).do("pick_and_place", obj="a", target="b")
     world.settle(0.5)
     assert P.on(world, "a", "b")
+
+
+def test_a_long_object_is_put_into_a_container_along_its_long_side() -> None:
+    """A large loaf lying across a small basket's long side is turned on its way in: across, it
+    comes to rest on both rims (V-CAGE rejected ten such attempts), along, it lies on the floor."""
+    from vcage.geometry import wrap_angle, yaw_of
+    from vcage.scene.compose import compose
+    from vcage.scene.spec import ObjectSpec, SceneSpec
+
+    world = compose(SceneSpec(objects=(ObjectSpec("bread", "bread", (0.45, -0.15), scale=1.1),
+                                       ObjectSpec("basket", "basket", (0.58, 0.12), yaw=1.3,
+                                                  scale=0.9)))).make_world()
+    world.settle(0.3)
+    Skills(world).do("pick_and_place", obj="bread", target="basket")
+    world.settle(0.5)
+    along = wrap_angle(yaw_of(world.object_mat("bread")) - yaw_of(world.object_mat("basket")))
+    assert abs(wrap_angle(2 * along)) / 2 < 0.2  # within 0.2 rad of along, either way round
+    assert P.inside(world, "bread", "basket")
