@@ -140,37 +140,36 @@ def pick_and_place(s: Skills, obj: str, target: str | None = None, placement: st
         plan = plan + lift(s)
     with s.after(plan):
         room = _room_axis(s, obj, target, placement) if target is not None else None
-        if target is not None and room is not None:
-            plan = plan + _turned_in(s, obj, target, placement, offset, room)
+        if room is not None:
+            plan = plan + _turned_in(s, obj, *room, offset)
         else:
             plan = plan + place(s, obj, target, placement, xy, offset=offset)
     return MotionPlan("pick_and_place", plan.waypoints)
 
 
-def _room_axis(s: Skills, obj: str, target: str, placement: str | None) -> float | None:
-    """The yaw along which the held ``obj``'s long side should lie in ``target``'s container, or None
-    where it need not turn (not a container; a round one; ``obj`` about as wide as long). In a drawer
-    it lies across the slide: put in lengthwise, it can catch on the body when the drawer is pushed
-    shut. In another container it lies along the longer side: across, a loaf can come to rest on both
-    rims of a small basket."""
+def _room_axis(s: Skills, obj: str, target: str,
+               placement: str | None) -> tuple[np.ndarray, float] | None:
+    """Where ``target``'s container holds the held ``obj`` (its surface) and the yaw along which
+    ``obj``'s long side should lie there, or None where it need not turn (not a container; a round
+    one; ``obj`` about as wide as long). In a drawer it lies across the slide: put in lengthwise, it
+    can catch on the body when the drawer is pushed shut. In another container it lies along the
+    longer side: across, a loaf can come to rest on both rims of a small basket."""
     place = CATALOG.get(s.world.object(target).type_name).placement(placement)
     if place.kind != "in":
         return None
-    _, host_yaw = placement_target(s, target, placement)
+    surface, host_yaw = placement_target(s, target, placement)
     if place.joint:
-        return host_yaw + math.pi / 2  # the drawer slides along its x
+        return surface, host_yaw + math.pi / 2  # the drawer slides along its x
     hx, hy = place.half_size
     sx, sy = CATALOG.get(s.world.object(obj).type_name).size[:2]
     if max(hx, hy) < ELONGATED * min(hx, hy) or max(sx, sy) < ELONGATED * min(sx, sy):
         return None
-    return host_yaw + (0.0 if hx >= hy else math.pi / 2)
+    return surface, host_yaw + (0.0 if hx >= hy else math.pi / 2)
 
 
-def _turned_in(s: Skills, obj: str, target: str, placement: str | None, offset: np.ndarray,
-               room: float) -> MotionPlan:
-    """Put the held ``obj`` (origin at ``offset`` from the TCP) into ``target``'s container with its
-    long side along ``room``, turning the hand by the smallest turn that does it."""
-    surface, _ = placement_target(s, target, placement)
+def _turned_in(s: Skills, obj: str, surface: np.ndarray, room: float, offset: np.ndarray) -> MotionPlan:
+    """Put the held ``obj`` (origin at ``offset`` from the TCP) down on ``surface`` in a container with
+    its long side along ``room``, turning the hand by the smallest turn that does it."""
     sx, sy = CATALOG.get(s.world.object(obj).type_name).size[:2]
     long_axis = yaw_of(s.world.object_mat(obj)) + (0.0 if sx >= sy else math.pi / 2)
     turn = wrap_half_turn(room - long_axis)
