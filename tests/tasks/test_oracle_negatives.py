@@ -172,6 +172,22 @@ def test_a_block_on_a_block_lying_on_its_side_is_on_it() -> None:
     assert not _value(world, "on", "top", "base")
 
 
+def test_a_die_rests_on_the_stand_on_whichever_face_is_down() -> None:
+    """A die turned over on the stand rests on it, though its origin (the centre of its "1" face) is a
+    whole side above the stand's top; on its side, half a side. Its lowest point and centre count."""
+    side = [np.cos(np.pi / 4), np.sin(np.pi / 4), 0.0, 0.0]  # 90 degrees about x
+    for face, (turn, lift) in {"over": ([0.0, 1.0, 0.0, 0.0], 0.04), "side": (side, 0.02)}.items():
+        world = _settled(ObjectSpec("die", "dice", (0.3, 0.2)),
+                         ObjectSpec("stand", "object_stand", (0.55, 0.0)))
+        center, _, _, _ = placement_frame(world, "stand", None)
+        _posed(world, "die", [0.55, 0.0, center[2] - world.table_top() + lift + 0.001, *turn])
+        world.forward()
+        world.settle(0.8)
+        up = abs(world.object_mat("die")[2, 2])
+        assert up > 0.9 if face == "over" else up < 0.1
+        assert _value(world, "on", "die", "stand"), face
+
+
 def test_released_is_false_while_the_hand_holds_the_object() -> None:
     world = _settled(ObjectSpec("block", "block", (0.55, 0.0)))
     skills = Skills(world)

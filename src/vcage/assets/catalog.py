@@ -20,8 +20,9 @@ class ObjectType:
     ``size`` is the full extent (x, y, z) in metres at scale 1 with the origin at the centre of the
     resting face. ``colors`` maps variant names to RGBA; the first is the default.
     ``fixed`` objects are welded to their support (no free joint), e.g. a wall switch plate.
-    ``any_face``: a cube whose faces are all alike (a block); it rests on whichever face is down and
-    carries what is put on whichever face is up (its placement ``pos`` is the top face's centre).
+    ``any_face``: a cube whose faces are all alike (a block, a die, a Rubik's cube); it rests on
+    whichever face is down and carries what is put on whichever face is up (its placement ``pos`` is
+    the top face's centre).
     """
 
     name: str

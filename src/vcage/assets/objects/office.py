@@ -302,6 +302,7 @@ CATALOG.add_type(ObjectType(
     colors={"white": (0.95, 0.95, 0.93, 1.0), "red": (0.8, 0.12, 0.12, 1.0),
             "green": (0.2, 0.6, 0.3, 1.0)},
     build=_dice, tags=frozenset({"graspable", "toy", "stackable", "cube"}), scale_range=(0.95, 1.1),
+    any_face=True,
     annotations=Annotations(
         grasps=grasp_pair("top", (0, 0, 0.025), DICE),
         stable_orientations=(
@@ -387,7 +388,7 @@ CATALOG.add_type(ObjectType(
     size=(RUBIK, RUBIK, RUBIK), mass=0.09,
     colors={"black": (0.08, 0.08, 0.09, 1.0)},
     build=_rubik_cube, tags=frozenset({"graspable", "toy", "stackable", "cube", "colorful"}),
-    scale_range=(0.95, 1.05),
+    scale_range=(0.95, 1.05), any_face=True,
     annotations=Annotations(grasps=grasp_pair("top", (0, 0, 0.035), RUBIK)),
 ))
 
