@@ -283,6 +283,24 @@ def test_a_press_hidden_from_the_front_by_a_cup_is_judged_from_the_top() -> None
     assert not verdict.accept and "covered" in verdict.reason, verdict.reason
 
 
+def test_a_press_on_a_bell_the_front_view_never_shows_is_judged_from_the_top() -> None:
+    """A cereal box stands between the bell and the front camera and hides all of it, before and
+    during the press (a Vanilla rollout hid a bell behind a basket so): the front view can tell
+    nothing, the top view's cover and depth decide, and a hovering hand still fails them."""
+    objects = (*BELL, O("box", "cereal_box", (0.64, 0.05)))
+    done = run(objects, press("bell", "the bell is rung"))
+    bell = done.obs.labels.index("bell")
+    fronts = (done.obs.before["front"], done.obs.during["front"])
+    assert not any((v.segmentation == bell).any() for v in fronts)
+    assert done.success
+    verdict = CRITIC.judge(done.obs)
+    assert verdict.accept, verdict.reason
+    hover = run(objects, press("bell", "the bell is rung"), "press_hover", 0)
+    assert hover.outcome.oracle["pressed(bell)"] is False
+    verdict = CRITIC.judge(hover.obs)
+    assert not verdict.accept and "short of pressing" in verdict.reason, verdict.reason
+
+
 def test_a_press_is_judged_at_its_own_lowest_moment() -> None:
     """A sweep after the press (knocking nothing over here) takes the hand lower than the press did;
     the views "during" the subtask are still those of the press, which the critic accepts."""

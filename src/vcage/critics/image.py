@@ -459,13 +459,16 @@ def _contact_hidden(obs: Observation, front: View, x: str) -> bool:
     """The hand goes down behind another object in the front view, over ``x``'s columns: its lowest
     pixels there border an object nearer the camera than the hand, so whether it met ``x`` cannot be
     seen from the front (a cup standing in front of a bell). Where the hand ends above the table or
-    beside ``x`` in plain sight, its contact (or its absence) is visible."""
+    beside ``x`` in plain sight, its contact (or its absence) is visible. Where ``x`` shows in the
+    front view neither now nor before (a bell behind a basket), nothing there can tell."""
     seg, depth = front.segmentation, front.depth
     mask = _mask(obs, front, x)
     if FRONT in obs.before:  # what the hand or the occluder hides now may have shown before
         mask = mask | _mask(obs, obs.before[FRONT], x)
-    if depth is None or not mask.any():
+    if depth is None:
         return False
+    if not mask.any():
+        return True
     robot = seg == ROBOT
     below, below_depth = seg[1:], depth[1:]
     occluder = (robot[:-1] & (below >= 0) & (below != obs.labels.index(x))
