@@ -214,6 +214,24 @@ def test_a_loaf_standing_on_end_in_the_basket_is_inside_it() -> None:
     assert verdict.accept, verdict.reason
 
 
+@pytest.mark.parametrize(("loaf_scale", "tilt"), [(1.1, 0.8), (0.9, 0.6)], ids=["underside", "top"])
+def test_a_loaf_leaning_from_the_floor_against_the_rim_is_inside_the_basket(loaf_scale: float,
+                                                                           tilt: float) -> None:
+    """Vanilla rollouts left loaves leaning in the basket, one end on the floor and the other against
+    the rim (inside for the oracle: the lowest point on the floor, the centre within the walls). The
+    critic read such a loaf as lying level: its underside its own height under its highest point, at
+    the rim (the large loaf), or its top no higher than its height above the rim (the small one). Its
+    sloping top says it leans: its underside is judged under the top's lower end, and its longest
+    side bounds its top."""
+    loaf = O("bread", "bread", (0.5, -0.12), scale=loaf_scale)
+    basket = O("basket", "basket", (0.58, 0.12), scale=0.9)
+    oracle, verdict = _set_down((loaf, basket), put_in("bread", "basket", "the bread is in the basket"),
+                                replace(loaf, xy=(0.62, 0.12), z=0.83),
+                                (np.cos(tilt / 2), 0.0, np.sin(tilt / 2), 0.0))  # about y, its low end away
+    assert oracle
+    assert verdict.accept, verdict.reason
+
+
 def test_a_loaf_lying_on_a_cup_above_the_rim_is_not_inside_the_basket() -> None:
     """A Vanilla rollout left a loaf lying flat on a cup that stood in the basket, all of it above the
     rim. It lies as it did on the table, so its underside is its own height under its top: above

@@ -18,7 +18,9 @@ simulator state. Each predicate is checked in image space:
   its base with a curved top before and shows a flat one now lies turned over (not asked in a
   container, where it may lie any way up). Put down on a surface that does not lean, ``a``'s top
   stands no higher than its type's height above that surface (in a container, where its top view
-  shows it turned, its longest side above the rim). In a
+  shows it turned or its top slopes as a leaning object's does, its longest side above the rim). In
+  a container its underside, its own height (seen on the table before) under its top, or under its
+  top's lower end where it leans, lies below the rim (not resting on it). In a
   drawer (a placement that comes out with a joint) the drawer is still open after the subtask, and
   ``a`` lies over what came out of ``b`` (not on its body), below the drawer's rim, and no lower
   than lying on the drawer's floor makes it.
@@ -33,8 +35,8 @@ simulator state. Each predicate is checked in image space:
   and at a full press that centre is :data:`FINGER_CONTACT` minus the button's travel (a lever's
   stroke), scaled by ``x``'s size, above ``x``'s highest point before. A press that stops short of
   :data:`PRESS_SHARE` of that is refused. Where the hand goes down behind an object standing in front
-  of ``x`` (a cup before a bell), the front view cannot show the contact; then the top view's cover
-  and depth, both required, decide.
+  of ``x`` (a cup before a bell), or ``x`` does not show in the front view at all, the front view
+  cannot show the contact; then the top view's cover and depth, both required, decide.
 - ``upright(x)``: ``x``'s top-view area (orthographic, so true to size wherever it stands) and the
   spread of its outline are close to what they were before, allowing for what the robot can hide;
   its front-view height did not drop.
@@ -100,6 +102,10 @@ HEIGHT_TOL = 0.01
 TOP_TOL = 0.01
 RIM_GAP = 0.003  # metres under a container's rim below which an object's underside lies in it
 RIM_PERCENTILE = 99  # of a container's top-view heights: its rim (one stray silhouette pixel is not)
+# Slope (rise over run) of the plane fitting an object's top-view heights above which it leans: the
+# loaves bridging a basket's rims in the balanced set and on Vanilla rollouts sloped 0.00-0.04; loaves
+# leaning from the floor onto the rim, which the oracle counts as in, 0.31-0.54
+LEVEL = 0.2
 UNDER_PX = 4
 # A placed object's top keeps its shape: one whose top lay at least CURVED metres (RMS) from a plane
 # before the subtask and under FLAT_TOP of that after it shows a flat face it did not show before
@@ -233,7 +239,9 @@ def _landed_on_other(obs: Observation, top: View, a: str, b: str, inside: bool) 
       its lowest pixel cannot exceed) at most its height above its resting face, which lies on
       ``b``'s surface. In ``b`` it may lie any way up (the oracle asks only that its lowest point be
       below the rim): where its top-view area changed as a turned object's does (see
-      :data:`AREA_RATIO`), its longest side takes the place of its height above the rim.
+      :data:`AREA_RATIO`), or its top slopes more than :data:`LEVEL` (it leans), its longest side
+      takes the place of its height above the rim.
+    - ``a`` rests on ``b``'s rim (see :func:`_on_rim`).
     - ``a`` lies over another object ``c`` whose top stood more than :data:`SUPPORT_TOL` above that
       surface: before the subtask the top view showed ``c`` where ``a`` is seen now, and ``c`` is
       still there (followed if it was pushed), so ``a`` lies above ``c`` and cannot be down on ``b``.
@@ -251,19 +259,25 @@ def _landed_on_other(obs: Observation, top: View, a: str, b: str, inside: bool) 
     leans = btype is not None and bool(btype.placements) and btype.placements[0].slope > 0
     was, now = int(_mask(obs, before, a).sum()), int(_mask(obs, top, a).sum())
     turned = was > 0 and not AREA_RATIO[0] <= now / was <= AREA_RATIO[1]
-    on_rim = _on_rim(obs, top, a, b) if inside and not turned else None
+    fit = _plane(top, _mask(obs, top, a)) if inside and not turned else None
+    leaning = fit is not None and fit[2] > LEVEL
+    on_rim = _on_rim(obs, top, a, b, fit if leaning else None) if inside and not turned else None
     return on_rim or _not_down(obs, top, a, surface, rim, f"{b}'s {'rim' if inside else 'surface'}",
-                               (a, b), standing=not leans, any_way_up=inside and turned)
+                               (a, b), standing=not leans, any_way_up=inside and (turned or leaning))
 
 
-def _on_rim(obs: Observation, top: View, a: str, b: str) -> str | None:
+def _on_rim(obs: Observation, top: View, a: str, b: str,
+            lean: tuple[np.ndarray, np.ndarray, float] | None = None) -> str | None:
     """Why ``a`` lies on ``b``'s rim rather than in it (None if it does not, or the views cannot
     tell). ``a`` lies as it lay before (its top-view area kept), so its underside is its own height
     under its top; before the subtask ``a`` stood on the table (the outline around it there), where
     its top was that height. An underside less than :data:`RIM_GAP` under the rim rests on it (a
     loaf bridging a basket), where the oracle wants it more than its contact tolerance under. The
     rim's height is read from all of ``b``'s pixels (at the :data:`RIM_PERCENTILE`): a thin wall
-    may be one pixel wide, with no inner pixel."""
+    may be one pixel wide, with no inner pixel. ``lean``: the plane fitting ``a``'s top (see
+    :func:`_plane`) where its slope says ``a`` leans (a loaf with one end on the floor and the other
+    against the rim): its lowest point lies under the top's lower end (the quarter of its pixels
+    lowest on that plane), and ``a`` is thicker upright through a point by the slope's secant."""
     before = obs.before.get(TOP)
     hb, ha = (_heights(before), _heights(top)) if before is not None else (None, None)
     if before is None or hb is None or ha is None:
@@ -276,7 +290,12 @@ def _on_rim(obs: Observation, top: View, a: str, b: str) -> str | None:
         return None  # not seen standing on the table before: its own height is not known
     rim = float(np.percentile(hb[mb], RIM_PERCENTILE))
     own = float(np.percentile(hb[_inner(was)], 95))
-    under = rim - (float(np.percentile(ha[_inner(now)], 95)) - own)
+    if lean is not None:
+        heights, plane, slope = lean
+        low_end = float(np.percentile(heights[plane <= np.percentile(plane, 25)], 95))
+        under = rim - (low_end - own * float(np.hypot(1.0, slope)))
+    else:
+        under = rim - (float(np.percentile(ha[_inner(now)], 95)) - own)
     if under < RIM_GAP:
         where = f"{100 * under:.1f} cm under" if under >= 0 else f"{-100 * under:.1f} cm above"
         return f"{a}'s underside is {where} {b}'s rim: it rests on the rim or on something, not down in {b}"
@@ -324,16 +343,24 @@ def _not_down(obs: Observation, top: View, a: str, surface: float | None, floor:
     return too_tall
 
 
-def _relief(view: View, mask: np.ndarray) -> float | None:
-    """How far (RMS, metres) the heights of ``mask``'s inner pixels lie from the plane that fits them
-    best: a dome's top lies far from any plane, a flat face on it (tilted or not)."""
+def _plane(view: View, mask: np.ndarray) -> tuple[np.ndarray, np.ndarray, float] | None:
+    """The plane that fits the heights of ``mask``'s inner pixels best (an orthographic view with
+    depth): those heights, the plane's at the same pixels, and its slope (rise over run); None with
+    fewer than :data:`MIN_RELIEF_PX` inner pixels."""
     heights, inner = _heights(view), _inner(mask)
-    if heights is None or inner.sum() < MIN_RELIEF_PX:
+    if heights is None or view.pixel_size is None or inner.sum() < MIN_RELIEF_PX:
         return None
     rows, cols = np.nonzero(inner)
     design = np.column_stack([rows, cols, np.ones_like(rows)]).astype(float)
     coef, *_ = np.linalg.lstsq(design, heights[inner], rcond=None)
-    return float(np.sqrt(np.mean((design @ coef - heights[inner]) ** 2)))
+    return heights[inner], design @ coef, float(np.hypot(coef[0], coef[1]) / view.pixel_size)
+
+
+def _relief(view: View, mask: np.ndarray) -> float | None:
+    """How far (RMS, metres) the heights of ``mask``'s inner pixels lie from the plane that fits them
+    best: a dome's top lies far from any plane, a flat face on it (tilted or not)."""
+    fit = _plane(view, mask)
+    return None if fit is None else float(np.sqrt(np.mean((fit[1] - fit[0]) ** 2)))
 
 
 def _turned_over(obs: Observation, top: View, a: str) -> str | None:
