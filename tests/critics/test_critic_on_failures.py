@@ -232,6 +232,21 @@ def test_a_loaf_leaning_from_the_floor_against_the_rim_is_inside_the_basket(loaf
     assert verdict.accept, verdict.reason
 
 
+def test_a_loaf_leaning_on_a_cup_that_stands_in_the_basket_is_inside_it() -> None:
+    """Vanilla composed scenes with a cup standing in the basket, taller than its walls; loaves put in
+    came to rest leaning on the cup, their lower end on the floor (inside for the oracle). From the
+    top a loaf lies over the cup, whose top stood above the rim, which says that a loaf lying level
+    rests on it; a leaning one may rest against it, and its lower end decides."""
+    scene = (O("bread", "bread", (0.5, -0.12)), O("basket", "basket", (0.58, 0.12)),
+             O("cup", "cup", (0.625, 0.12), z=0.735))  # on the basket's floor
+    tilt = 0.6  # about y, its raised end towards the cup
+    oracle, verdict = _set_down(scene, put_in("bread", "basket", "the bread is in the basket"),
+                                O("bread", "bread", (0.57, 0.12), z=0.83),
+                                (np.cos(tilt / 2), 0.0, -np.sin(tilt / 2), 0.0))
+    assert oracle
+    assert verdict.accept, verdict.reason
+
+
 def test_a_loaf_lying_on_a_cup_above_the_rim_is_not_inside_the_basket() -> None:
     """A Vanilla rollout left a loaf lying flat on a cup that stood in the basket, all of it above the
     rim. It lies as it did on the table, so its underside is its own height under its top: above

@@ -245,6 +245,8 @@ def _landed_on_other(obs: Observation, top: View, a: str, b: str, inside: bool) 
     - ``a`` lies over another object ``c`` whose top stood more than :data:`SUPPORT_TOL` above that
       surface: before the subtask the top view showed ``c`` where ``a`` is seen now, and ``c`` is
       still there (followed if it was pushed), so ``a`` lies above ``c`` and cannot be down on ``b``.
+      Not asked of ``a`` leaning in ``b``: it may lean against ``c`` standing in ``b`` (a loaf on
+      a cup that stood in the basket, its lower end on the floor); its lower end decides.
     """
     before = obs.before.get(TOP)
     hb = _heights(before) if before is not None else None
@@ -262,8 +264,10 @@ def _landed_on_other(obs: Observation, top: View, a: str, b: str, inside: bool) 
     fit = _plane(top, _mask(obs, top, a)) if inside and not turned else None
     leaning = fit is not None and fit[2] > LEVEL
     on_rim = _on_rim(obs, top, a, b, fit if leaning else None) if inside and not turned else None
+    # leaning, ``a`` may rest against what stands in ``b``: its lower end decides (``on_rim``)
+    skip = tuple(obs.labels) if leaning else (a, b)
     return on_rim or _not_down(obs, top, a, surface, rim, f"{b}'s {'rim' if inside else 'surface'}",
-                               (a, b), standing=not leans, any_way_up=inside and (turned or leaning))
+                               skip, standing=not leans, any_way_up=inside and (turned or leaning))
 
 
 def _on_rim(obs: Observation, top: View, a: str, b: str,
