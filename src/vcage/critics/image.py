@@ -127,8 +127,12 @@ HAND_TOP = 0.307  # metres
 FINGER_CONTACT = 0.033  # metres
 # Share of a full press the hand must reach: a button's travel (the oracle asks for all of it; the
 # rest is the estimate's margin), a lever's stroke (its full close; the oracle asks for 0.15 of the
-# stapler's 0.25 rad, 0.6 of the stroke)
-PRESS_SHARE = {"button": 0.75, "lever": 0.5}
+# stapler's 0.25 rad, 0.6 of the stroke). The estimate errs by about 1.5 mm either way, a third of a
+# bell's 4 mm travel: on the balanced set (seeds 5-9) the presses the oracle counted read at least
+# 0.9 of the travel and light ones at most -0.3 (they stop above the button); on Vanilla rollouts
+# counted ones read down to 0.65 (0.75 refused two) and uncounted ones at most 0.15. 0.4 lies in
+# both gaps
+PRESS_SHARE = {"button": 0.4, "lever": 0.5}
 # The hand pressing a button hides it from the top view: the object's top (its pixels within TOP_BAND
 # metres of its highest point, where the button or lever is) must be this much hidden by the robot
 TOP_BAND = 0.004
