@@ -100,7 +100,10 @@ HEIGHT_RATIO = 0.8  # front-view height after / before for an object that stayed
 SUPPORT_TOL = 0.02
 HEIGHT_TOL = 0.01
 TOP_TOL = 0.01
-RIM_GAP = 0.003  # metres under a container's rim below which an object's underside lies in it
+# Metres under a container's rim below which an object's underside lies in it: loaves lying level
+# read 3.6 cm or more under the basket's rim where the oracle counted them in, 0.0-0.4 cm where they
+# rested on the rim or on its contents (balanced set and Vanilla rollouts; 0.3 cm let one through)
+RIM_GAP = 0.01
 RIM_PERCENTILE = 99  # of a container's top-view heights: its rim (one stray silhouette pixel is not)
 # Slope (rise over run) of the plane fitting an object's top-view heights above which it leans: the
 # loaves bridging a basket's rims in the balanced set and on Vanilla rollouts sloped 0.00-0.04; loaves
