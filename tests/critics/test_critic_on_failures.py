@@ -181,6 +181,17 @@ def test_a_mouse_on_its_back_on_the_pad_is_not_on_it() -> None:
     assert not verdict.accept and "turned over" in verdict.reason, verdict.reason
 
 
+def test_a_mouse_tipped_over_at_a_slant_on_the_pad_is_not_on_it() -> None:
+    """A Vanilla rollout left a mouse on the pad tilted 2.5 rad (this orientation): most of its flat
+    underside up, part of its dome showing, so its top lies far enough from a plane (0.46 of its
+    relief before) to pass for a dome. A quadric says more: the dome that bent down before barely
+    bends now."""
+    oracle, verdict = _set_down(MOUSE_PAD, put_on("mouse", "pad", "the mouse is on the pad"),
+                                O("mouse", "mouse", (0.583, 0.107), z=0.8), (0.207, -0.625, 0.714, -0.238))
+    assert not oracle
+    assert not verdict.accept and "bends" in verdict.reason, verdict.reason
+
+
 def test_a_mouse_standing_on_its_end_on_the_pad_is_not_on_it() -> None:
     """Vanilla rollouts left mice standing on an end or propped on clutter on the pad: from the top
     they lie over it, their lowest point is down on it and their top is no flatter than before. Stood

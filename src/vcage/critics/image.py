@@ -15,15 +15,15 @@ simulator state. Each predicate is checked in image space:
   top view's depth, ``a`` is down on ``b``: its lowest point is no higher than its type's height
   above ``b``'s surface (for ``inside``, its rim), and it does not lie over another object that
   stood higher than that surface before the subtask (clutter on the target); an object that stood on
-  its base with a curved top before and shows a flat one now lies turned over (not asked in a
-  container, where it may lie any way up). Put down on a surface that does not lean, ``a``'s top
-  stands no higher than its type's height above that surface (in a container, where its top view
-  shows it turned or its top slopes as a leaning object's does, its longest side above the rim). In
-  a container its underside, its own height (seen on the table before) under its top, or under its
-  top's lower end where it leans, lies below the rim (not resting on it). In a
-  drawer (a placement that comes out with a joint) the drawer is still open after the subtask, and
-  ``a`` lies over what came out of ``b`` (not on its body), below the drawer's rim, and no lower
-  than lying on the drawer's floor makes it.
+  its base with a curved top before and shows a flat one now, or a domed one that barely bends now,
+  lies turned over (not asked in a container, where it may lie any way up). Put down on a surface
+  that does not lean, ``a``'s top stands no higher than its type's height above that surface (in a
+  container, where its top view shows it turned or its top slopes as a leaning object's does, its
+  longest side above the rim). In a container its underside, its own height (seen on the table
+  before) under its top, or under its top's lower end where it leans, lies below the rim (not
+  resting on it). In a drawer (a placement that comes out with a joint) the drawer is still open
+  after the subtask, and ``a`` lies over what came out of ``b`` (not on its body), below the
+  drawer's rim, and no lower than lying on the drawer's floor makes it.
 - ``released(a)``: after the retreat, the robot does not touch ``a`` in every view that shows it
   (a projection overlap in one view is not contact); ``a`` hidden in every view is not released.
 - ``pressed(x)``: in the views at the subtask's deepest moment the robot touches ``x`` (front view,
@@ -116,6 +116,13 @@ UNDER_PX = 4
 CURVED = 0.003
 FLAT_TOP = 0.3
 MIN_RELIEF_PX = 12
+# ... or a top that was a dome (a quadric leaves under DOME_FIT of its relief from a plane: mice
+# 0.2-0.5, a seal's knob on its disc 0.5-1.0) and now bends down under FLAT_BEND as much as it did:
+# Vanilla rollouts left mice tilted 2.4-2.6 rad on the pad (part of the dome, most of the flat
+# underside up) that bent 0.3-0.5 as much, relief 0.46-0.56; mice the oracle found on the pad bent
+# at least 0.93 as much
+DOME_FIT = 0.5
+FLAT_BEND = 0.6
 # ... judged only for an object that stood on its base before: its top-view area between these shares
 # of its type's footprint (size x by size y, times its smallest and largest scale squared); a round
 # or rounded object covers about 0.8 of it
@@ -378,8 +385,10 @@ def _turned_over(obs: Observation, top: View, a: str) -> str | None:
     """Why ``a`` lies turned over (None if its top kept its shape, or the views cannot tell): it stood
     on its base before the subtask (see :data:`FOOTPRINT`) with a curved top (at least :data:`CURVED`
     from a plane), and its top is now nearly flat (under :data:`FLAT_TOP` of that), as a mouse on its
-    back shows its flat underside. Containers are left out: how much of their inside shows changes
-    with what stands around them."""
+    back shows its flat underside; or its top was a dome and bends down under :data:`FLAT_BEND` as
+    much now (a mouse tipped over at a slant shows a flat face and part of its dome; see
+    :func:`_dome`). Containers are left out: how much of their inside shows changes with what stands
+    around them."""
     otype = _type_of(obs, a)
     before = obs.before.get(TOP)
     if (otype is None or before is None or before.pixel_size is None
@@ -391,10 +400,31 @@ def _turned_over(obs: Observation, top: View, a: str) -> str | None:
     if not FOOTPRINT[0] * lo ** 2 <= share <= FOOTPRINT[1] * hi ** 2:
         return None  # not standing on its base before (a tilted block shows a side: two faces, no plane)
     was, now = _relief(before, mask), _relief(top, _mask(obs, top, a))
-    if was is None or now is None or was < CURVED or now >= FLAT_TOP * was:
+    if was is None or now is None or was < CURVED:
         return None
-    return (f"{a}'s top is flat now ({1000 * now:.1f} mm from a plane, {1000 * was:.1f} mm before): "
-            "it lies turned over")
+    if now < FLAT_TOP * was:
+        return (f"{a}'s top is flat now ({1000 * now:.1f} mm from a plane, {1000 * was:.1f} mm before): "
+                "it lies turned over")
+    dome, bend = _dome(before, mask), _dome(top, _mask(obs, top, a))
+    if dome is None or bend is None or dome[1] >= DOME_FIT * was or bend[0] >= FLAT_BEND * dome[0]:
+        return None
+    return (f"{a}'s top bends x{bend[0] / dome[0]:.2f} as much as before (a dome then): it lies turned "
+            "over, or tipped onto its top")
+
+
+def _dome(view: View, mask: np.ndarray) -> tuple[float, float] | None:
+    """How much the heights of ``mask``'s inner pixels bend down (1/m: the quadric fitting them best,
+    its most downward curvature) and how far (RMS, metres) they lie from that quadric."""
+    heights, inner = _heights(view), _inner(mask)
+    if heights is None or view.pixel_size is None or inner.sum() < MIN_RELIEF_PX:
+        return None
+    rows, cols = np.nonzero(inner)
+    r, c = rows - rows.mean(), cols - cols.mean()
+    design = np.column_stack([r * r, c * c, r * c, r, c, np.ones_like(r)]).astype(float)
+    coef, *_ = np.linalg.lstsq(design, heights[inner], rcond=None)
+    hessian = np.array([[2 * coef[0], coef[2]], [coef[2], 2 * coef[1]]]) / view.pixel_size ** 2
+    residual = float(np.sqrt(np.mean((design @ coef - heights[inner]) ** 2)))
+    return float(-np.linalg.eigvalsh(hessian)[0]), residual
 
 
 def _surface(obs: Observation, b: str, top: float) -> float | None:
