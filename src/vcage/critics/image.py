@@ -361,17 +361,26 @@ def _not_down(obs: Observation, top: View, a: str, surface: float | None, floor:
     return too_tall
 
 
-def _plane(view: View, mask: np.ndarray) -> tuple[np.ndarray, np.ndarray, float] | None:
-    """The plane that fits the heights of ``mask``'s inner pixels best (an orthographic view with
-    depth): those heights, the plane's at the same pixels, and its slope (rise over run); None with
-    fewer than :data:`MIN_RELIEF_PX` inner pixels."""
+def _top_heights(view: View, mask: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+    """The heights of ``mask``'s inner pixels in an orthographic view with depth and their rows and
+    columns about their mean; None with fewer than :data:`MIN_RELIEF_PX` of them."""
     heights, inner = _heights(view), _inner(mask)
     if heights is None or view.pixel_size is None or inner.sum() < MIN_RELIEF_PX:
         return None
     rows, cols = np.nonzero(inner)
-    design = np.column_stack([rows, cols, np.ones_like(rows)]).astype(float)
-    coef, *_ = np.linalg.lstsq(design, heights[inner], rcond=None)
-    return heights[inner], design @ coef, float(np.hypot(coef[0], coef[1]) / view.pixel_size)
+    return heights[inner], rows - rows.mean(), cols - cols.mean()
+
+
+def _plane(view: View, mask: np.ndarray) -> tuple[np.ndarray, np.ndarray, float] | None:
+    """The plane that fits the heights of ``mask``'s inner pixels best (see :func:`_top_heights`):
+    those heights, the plane's at the same pixels, and its slope (rise over run)."""
+    top = _top_heights(view, mask)
+    if top is None or view.pixel_size is None:
+        return None
+    heights, r, c = top
+    design = np.column_stack([r, c, np.ones_like(r)])
+    coef, *_ = np.linalg.lstsq(design, heights, rcond=None)
+    return heights, design @ coef, float(np.hypot(coef[0], coef[1]) / view.pixel_size)
 
 
 def _relief(view: View, mask: np.ndarray) -> float | None:
@@ -415,15 +424,14 @@ def _turned_over(obs: Observation, top: View, a: str) -> str | None:
 def _dome(view: View, mask: np.ndarray) -> tuple[float, float] | None:
     """How much the heights of ``mask``'s inner pixels bend down (1/m: the quadric fitting them best,
     its most downward curvature) and how far (RMS, metres) they lie from that quadric."""
-    heights, inner = _heights(view), _inner(mask)
-    if heights is None or view.pixel_size is None or inner.sum() < MIN_RELIEF_PX:
+    top = _top_heights(view, mask)
+    if top is None or view.pixel_size is None:
         return None
-    rows, cols = np.nonzero(inner)
-    r, c = rows - rows.mean(), cols - cols.mean()
-    design = np.column_stack([r * r, c * c, r * c, r, c, np.ones_like(r)]).astype(float)
-    coef, *_ = np.linalg.lstsq(design, heights[inner], rcond=None)
+    heights, r, c = top
+    design = np.column_stack([r * r, c * c, r * c, r, c, np.ones_like(r)])
+    coef, *_ = np.linalg.lstsq(design, heights, rcond=None)
     hessian = np.array([[2 * coef[0], coef[2]], [coef[2], 2 * coef[1]]]) / view.pixel_size ** 2
-    residual = float(np.sqrt(np.mean((design @ coef - heights[inner]) ** 2)))
+    residual = float(np.sqrt(np.mean((design @ coef - heights) ** 2)))
     return float(-np.linalg.eigvalsh(hessian)[0]), residual
 
 
