@@ -273,9 +273,10 @@ def _landed_on_other(obs: Observation, top: View, a: str, b: str, inside: bool) 
     surface = rim if inside else _surface(obs, b, rim)
     btype = _type_of(obs, b)
     leans = btype is not None and bool(btype.placements) and btype.placements[0].slope > 0
-    was, now = int(_mask(obs, before, a).sum()), int(_mask(obs, top, a).sum())
+    ma = _mask(obs, top, a)
+    was, now = int(_mask(obs, before, a).sum()), int(ma.sum())
     turned = was > 0 and not AREA_RATIO[0] <= now / was <= AREA_RATIO[1]
-    fit = _plane(top, _mask(obs, top, a)) if inside and not turned else None
+    fit = _plane(top, ma) if inside and not turned else None
     leaning = fit is not None and fit[2] > LEVEL
     on_rim = _on_rim(obs, top, a, b, fit if leaning else None) if inside and not turned else None
     # leaning, ``a`` may rest against what stands in ``b``: its lower end decides (``on_rim``)
