@@ -93,3 +93,23 @@ def test_depth_from_the_orthographic_top_camera_is_the_height_below_it() -> None
     assert np.median(heights[seg == -1]) == pytest.approx(0.0, abs=1e-3)  # the table top
     for name, top in (("block", 0.045), ("cup", 0.09), ("bell", 0.06)):  # catalog heights
         assert heights[seg == world.object_names.index(name)].max() == pytest.approx(top, abs=2e-3), name
+
+
+@pytest.mark.parametrize("center_x", [0.6, 0.75])
+def test_the_top_views_robot_pixel_places_objects_where_they_stand(center_x: float) -> None:
+    """The robot's base pixel (the top view's calibration) and the pixel size put an object's pixels
+    where it stands: image up is +x (away from the robot), image right is -y; on a table whose centre
+    (and so the camera's) lies elsewhere, the base's pixel moves and the objects' still agree."""
+    blocks = (ObjectSpec("near", "block", (0.45, 0.15)), ObjectSpec("far", "block", (0.7, -0.2)))
+    spec = SceneSpec(objects=blocks, table=TableSpec(center_x=center_x))
+    world = compose(spec).make_world()
+    world.settle(0.2)
+    with Renderer(world, 320, 240) as r:
+        base, size, seg = r.robot_pixel("top"), r.pixel_size("top"), r.segmentation("top")
+        assert r.robot_pixel("front") is None  # a perspective view has no such calibration
+    assert base is not None and size is not None
+    for name in ("near", "far"):
+        rows, cols = np.nonzero(seg == world.object_names.index(name))
+        x, y = world.object_com(name)[:2]
+        assert rows.mean() == pytest.approx(base[0] - x / size, abs=1.0), name
+        assert cols.mean() == pytest.approx(base[1] - y / size, abs=1.0), name

@@ -27,6 +27,7 @@ class View:
     segmentation: np.ndarray  # (H, W) int32: object index into Observation.labels, -1 other, -2 robot
     depth: np.ndarray | None = None  # (H, W) metres along the view axis (orthographic: straight down)
     pixel_size: float | None = None  # metres per pixel on the table (orthographic cameras)
+    robot_base: tuple[float, float] | None = None  # (row, col) of the robot's base (orthographic cameras)
 
 
 @dataclass(frozen=True)

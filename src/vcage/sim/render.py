@@ -18,6 +18,7 @@ import numpy as np
 
 from vcage.errors import ConfigError
 from vcage.sim.batching import batched
+from vcage.sim.camera import OrthoCamera
 from vcage.sim.lod import render_model
 from vcage.sim.world import World
 
@@ -116,6 +117,20 @@ class Renderer:
         if not self._orthographic(camera):
             return None
         return float(self.world.model.cam_fovy[self.world.model.camera(camera).id]) / self.height
+
+    def robot_pixel(self, camera: str) -> tuple[float, float] | None:
+        """(row, column) at which the robot's base stands in an orthographic camera's view fixed in
+        the world (its hand-eye calibration: the point may lie outside the image); None for other
+        cameras."""
+        if not self._orthographic(camera) or int(self.world.model.cam_bodyid[
+                self.world.model.camera(camera).id]) != 0:
+            return None
+        model, base = self.world.model, self.world.robot.base_body
+        if int(model.body_parentid[base]) != 0:
+            raise ConfigError("the robot's base is not fixed in the world: its pixel needs simulator data")
+        cam = OrthoCamera.fixed(model, camera, self.width, self.height)
+        u, v = cam.to_pixel(model.body_pos[base][None, :2], float(model.body_pos[base][2]))[0]
+        return float(v), float(u)
 
     def segmentation(self, camera: str) -> np.ndarray:
         """Per-pixel object index into ``world.object_names``; :data:`ROBOT` for the robot, else -1."""

@@ -23,7 +23,8 @@ def render_views(renderer: Renderer, cameras: tuple[str, ...] = CRITIC_CAMERAS,
                  depth_cameras: tuple[str, ...] = DEPTH_CAMERAS) -> dict[str, View]:
     """The critic's views of the world as it is now (the pipeline's verifier renders the same)."""
     return {cam: View(renderer.rgb(cam), renderer.segmentation(cam),
-                      renderer.depth(cam) if cam in depth_cameras else None, renderer.pixel_size(cam))
+                      renderer.depth(cam) if cam in depth_cameras else None, renderer.pixel_size(cam),
+                      renderer.robot_pixel(cam))
             for cam in cameras}
 
 

@@ -12,7 +12,7 @@
    not, e.g. an object the image model dropped; between equals the larger template keeps it).
 4. **Lose**: an object whose best place agrees with its template on under half its pixels is lost.
 5. **Lift** the origin pixel to the table with the camera's exact geometry
-   (:class:`~vcage.synthesis.camera.OrthoCamera`), and the image rotation to a yaw.
+   (:class:`~vcage.sim.camera.OrthoCamera`), and the image rotation to a yaw.
 """
 
 from __future__ import annotations

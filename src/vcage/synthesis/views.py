@@ -12,9 +12,9 @@ import mujoco
 import numpy as np
 
 from vcage.scene.compose import TOP_CAMERA
+from vcage.sim.camera import OrthoCamera
 from vcage.sim.render import Renderer
 from vcage.sim.world import World
-from vcage.synthesis.camera import OrthoCamera
 
 WIDTH, HEIGHT = 640, 480
 AWAY = 100.0  # metres: where objects go while the empty table is rendered

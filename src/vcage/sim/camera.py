@@ -40,6 +40,21 @@ class OrthoCamera:
         return cls(tuple(float(v) for v in world.data.cam_xpos[cam.id]), axes,  # type: ignore[arg-type]
                    float(model.cam_fovy[cam.id]), width, height)
 
+    @classmethod
+    def fixed(cls, model: mujoco.MjModel, camera: str, width: int, height: int) -> OrthoCamera:
+        """The camera of ``model`` fixed in the world (on its world body), read from the model alone:
+        no simulator data is computed or touched."""
+        cam = model.camera(camera)
+        if int(model.cam_projection[cam.id]) != int(mujoco.mjtProjection.mjPROJ_ORTHOGRAPHIC):
+            raise ConfigError(f"camera {camera!r} is not orthographic")
+        if int(model.cam_bodyid[cam.id]) != 0:
+            raise ConfigError(f"camera {camera!r} moves with a body; its pose needs the simulator's data")
+        mat = np.zeros(9)
+        mujoco.mju_quat2Mat(mat, model.cam_quat[cam.id])
+        axes = tuple(tuple(float(v) for v in mat.reshape(3, 3)[:, i]) for i in range(3))
+        return cls(tuple(float(v) for v in model.cam_pos[cam.id]), axes,  # type: ignore[arg-type]
+                   float(model.cam_fovy[cam.id]), width, height)
+
     @property
     def pixel_size(self) -> float:
         """Metres per pixel."""
