@@ -39,7 +39,7 @@ simulator state. Each predicate is checked in image space:
   cannot show the contact; then the top view's cover and depth, both required, decide.
 - ``upright(x)``: ``x``'s top-view area (orthographic, so true to size wherever it stands) and the
   spread of its outline are close to what they were before, allowing for what the robot can hide;
-  its front-view height did not drop.
+  its highest point (the top view's depth; without it, its front-view height) did not drop.
 - ``on_table(a)``: released, not over another object in the top view, and down on the table by the
   top view's heights (as for ``on``).
 - ``left_of`` / ``right_of``: column order in the top view (+y, the robot's left, is image left).
@@ -90,7 +90,7 @@ STILL = 0.9  # share of an object's pixels within its outline before for it to c
 ROW_TOL = 3  # pixels of slack for row comparisons in the front view
 AREA_RATIO = (0.8, 1.25)  # top-view (orthographic) area after / before of an object that stayed upright
 SHAPE_RATIO = 1.2  # top-view long-axis spread after / before (either way) of an object that stayed upright
-HEIGHT_RATIO = 0.8  # front-view height after / before for an object that stayed upright
+HEIGHT_RATIO = 0.8  # highest point (front view without depth: height) after / before, stayed upright
 # How far (metres) the top of an object that ``a`` lies over may stand above ``b``'s surface (the
 # oracle's tolerance for "on"), and how far above what resting on ``b`` allows ``a``'s lowest top-view
 # point may stand (half of it: the bound allows the oracle's 2 cm, but on 270 successes of the
@@ -736,6 +736,14 @@ def _upright(obs: Observation, x: str) -> tuple[bool, str]:
             axes = spread(ma)[-1] / max(1e-9, spread(mb)[-1])
             if not 1 / SHAPE_RATIO <= axes <= SHAPE_RATIO:
                 return False, f"{x}'s top-view outline stretched by x{axes:.2f} (tipped over?)"
+    hb, ha = _heights(before), _heights(after)
+    if hb is not None and ha is not None and mb.any() and ma.any():  # its highest point, from the top
+        was, now = (float(np.percentile(h[_inner(m)], 95)) for h, m in ((hb, mb), (ha, ma)))
+        if now < HEIGHT_RATIO * was:
+            return False, f"{x}'s top stands x{now / max(was, 1e-9):.2f} as high as before (tipped over?)"
+        return True, "upright"
+    # without the top view's depth, its height in the front view (which a thin object turned about
+    # the vertical changes too: a board's plate seen edge-on, its top edge runs away from the camera)
     rb, ra = rows_of(_mask(obs, fb, x)), rows_of(_mask(obs, fa, x))
     if rb and ra and (ra[1] - ra[0] + 1) < HEIGHT_RATIO * (rb[1] - rb[0] + 1):
         return False, f"{x} looks lower in the front view than before (tipped over?)"
