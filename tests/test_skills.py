@@ -155,3 +155,20 @@ def test_a_long_object_is_put_into_a_container_along_its_long_side() -> None:
     along = wrap_angle(yaw_of(world.object_mat("bread")) - yaw_of(world.object_mat("basket")))
     assert abs(wrap_angle(2 * along)) / 2 < 0.2  # within 0.2 rad of along, either way round
     assert P.inside(world, "bread", "basket")
+
+
+@pytest.mark.parametrize(("xy", "yaw"), [((0.55, 0.0), 0.0), ((0.68, 0.24), 0.3), ((0.45, -0.2), 2.0)])
+def test_turn_to_face_puts_a_board_down_where_it_stood_facing_the_robot(xy: tuple[float, float],
+                                                                        yaw: float) -> None:
+    """Half a turn at the far edge of the work area too: the grasp is taken so that the wrist turns
+    about its heading (at the hand's first heading and a half turn more, the IK gave up there)."""
+    from vcage.scene.compose import compose
+    from vcage.scene.spec import ObjectSpec, SceneSpec
+
+    world = compose(SceneSpec(objects=(ObjectSpec("board", "qr_board", xy, yaw=yaw),))).make_world()
+    world.settle(0.3)
+    assert not P.facing(world, "board")
+    Skills(world).do("turn_to_face", obj="board")
+    world.settle(0.5)
+    assert P.facing(world, "board") and P.upright(world, "board") and P.on_table(world, "board")
+    assert np.linalg.norm(world.object_pos("board")[:2] - np.asarray(xy)) < 0.03

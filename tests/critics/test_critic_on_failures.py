@@ -17,7 +17,7 @@ from critics.faulted import Run, run
 from vcage.critics.base import Verdict
 from vcage.critics.image import ROBOT, ImageCritic
 from vcage.critics.masks import touch
-from vcage.planning.goals import close_drawer, open_drawer, press, put_in, put_on
+from vcage.planning.goals import close_drawer, open_drawer, press, put_in, put_on, turn_to_face
 from vcage.planning.schema import Predicate, Subtask
 from vcage.scene.compose import compose
 from vcage.scene.spec import ObjectSpec as O
@@ -45,6 +45,8 @@ STACK = (O("a", "block", (0.5, -0.12)), O("b", "block", (0.55, 0.1)))
 ROW_LEFT = (O("a", "block", (0.5, -0.1)), O("b", "block", (0.55, 0.05)))
 ROW_RIGHT = (O("a", "block", (0.5, 0.1)), O("b", "block", (0.55, -0.05)))
 CABINET = (O("cab", "cabinet", (0.68, 0.05), yaw=-0.2),)
+BOARD_AWAY = (O("board", "qr_board", (0.55, 0.1)),)  # its code faces +x, away from the robot
+BOARD_SIDEWAYS = (O("board", "qr_board", (0.55, 0.0), yaw=np.pi / 2),)  # its code faces the robot's left
 
 SCENARIOS: dict[str, tuple[tuple[O, ...], Subtask]] = {
     "on": (BLOCK_PAD, put_on("block", "pad", "the block is on the pad")),
@@ -70,6 +72,7 @@ SCENARIOS: dict[str, tuple[tuple[O, ...], Subtask]] = {
     "closed": (CABINET, close_drawer("cab", "the drawer is shut")),  # after opening it (BEFORE)
     "inside_drawer": ((*CABINET, O("soap", "soap", (0.5, -0.15))),
                       put_in("soap", "cab", "the soap is in the open drawer")),  # after opening it
+    "facing": (BOARD_SIDEWAYS, turn_to_face("board", "the board faces the robot")),
 }
 BEFORE = {"closed": (open_drawer("cab", "the drawer is open"),),
           "inside_drawer": (open_drawer("cab", "the drawer is open"),)}
@@ -102,6 +105,9 @@ FAILURES = [
     ("closed", "pull_short", 2, "closed(cab)"),
     # over the cabinet's hull, as resting in it would be, but mostly on its body beside the drawer
     ("inside_drawer", "release_late", 1, "inside(soap, cab)"),
+    # turned 30-60% of the quarter turn it needed: its plain back shows obliquely to the front camera,
+    # as it does when the board faces the robot; only its axis from the top tells
+    ("facing", "turn_short", 0, "facing(board)"),
 ]
 
 
@@ -352,6 +358,19 @@ def test_a_press_is_judged_at_its_own_lowest_moment() -> None:
     assert result.applied and result.success, result.outcome.oracle
     verdict = CRITIC.judge(result.obs)
     assert verdict.accept, verdict.reason
+
+
+def test_a_board_put_back_with_its_code_away_from_the_robot_does_not_face_it() -> None:
+    """Picked up and put back unturned, the board's plate lies across the way to the robot, as when
+    it faces it: only the front view (the code's contrast towards the front camera, opposite the
+    robot) tells that it faces away."""
+    here = BOARD_AWAY[0].xy
+    result = run(BOARD_AWAY, _sub("pick_and_place", {"obj": "board", "xy": list(here)},
+                                  ("facing", ("board",)), ("released", ("board",))))
+    assert result.outcome.oracle["facing(board)"] is False and result.outcome.oracle["released(board)"]
+    verdict = CRITIC.judge(result.obs)
+    assert verdict.details["checks"] == {"facing(board)": False, "released(board)": True}, verdict.reason
+    assert "faces away from the robot" in verdict.reason
 
 
 def test_the_checks_under_test_cover_every_image_check() -> None:

@@ -131,6 +131,19 @@ def test_plan_schema_refuses_drawers_used_out_of_order_or_on_objects_without_one
         Plan.model_validate(soap_drawer)
 
 
+def test_plan_schema_refuses_to_turn_an_object_without_a_face_towards_the_robot() -> None:
+    desk = next(g for g in GOALS if g.name == "open_the_front_desk").plan("open the front desk").model_dump()
+    Plan.model_validate(desk)  # the board has a face: its code
+    bell_turned = json.loads(json.dumps(desk))
+    bell_turned["subtasks"][0]["args"]["obj"] = "bell"
+    with pytest.raises(ValueError, match="turns 'bell', a bell, to face the robot, but it has no face"):
+        Plan.model_validate(bell_turned)
+    bell_checked = json.loads(json.dumps(desk))
+    bell_checked["subtasks"][2]["predicates"].append({"name": "facing", "args": ["bell"]})
+    with pytest.raises(ValueError, match="subtask 2 \\(press\\) turns 'bell'"):
+        Plan.model_validate(bell_checked)
+
+
 # -- LLM planner against a local OpenAI-protocol server ------------------------------------------
 
 @pytest.fixture()

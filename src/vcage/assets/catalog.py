@@ -10,6 +10,8 @@ from vcage.assets.parts import RGBA, PartBuilder
 from vcage.errors import CatalogError
 from vcage.registry import Registry
 
+FACE_KINDS = frozenset({"display", "outlet"})  # functional points that are meant to face someone
+
 Builder = Callable[[PartBuilder], None]
 
 
@@ -62,6 +64,13 @@ class ObjectType:
 
     def functional_point(self, name: str | None = None) -> FunctionalPoint:
         return _find(self.functional_points, name, f"{self.name} functional point")
+
+    @property
+    def face(self) -> FunctionalPoint | None:
+        """The functional point that is turned towards someone (a board's code, a fan's outlet): the
+        first of a kind in :data:`FACE_KINDS` that points sideways; None if it has none."""
+        return next((p for p in self.functional_points
+                     if p.kind in FACE_KINDS and abs(p.direction[2]) < 0.5), None)
 
     @property
     def drawer_handles(self) -> tuple[FunctionalPoint, ...]:

@@ -40,6 +40,9 @@ simulator state. Each predicate is checked in image space:
 - ``upright(x)``: ``x``'s top-view area (orthographic, so true to size wherever it stands) and the
   spread of its outline are close to what they were before, allowing for what the robot can hide;
   its highest point (the top view's depth; without it, its front-view height) did not drop.
+- ``facing(x)``: the short axis of ``x``'s tall part from the top (a board's plate, a fan's head)
+  points at the robot's base, whose pixel the top view carries (its calibration), and the front
+  camera, opposite the robot, sees the plain back rather than the detailed face (its contrast).
 - ``on_table(a)``: released, not over another object in the top view, and down on the table by the
   top view's heights (as for ``on``).
 - ``left_of`` / ``right_of``: column order in the top view (+y, the robot's left, is image left).
@@ -127,6 +130,14 @@ FLAT_BEND = 0.6
 # of its type's footprint (size x by size y, times its smallest and largest scale squared); a round
 # or rounded object covers about 0.8 of it
 FOOTPRINT = (0.6, 1.15)
+# facing: the oracle's tolerance (radians); the tall part's long/short spread; the front view's
+# luminance P90/P10 over the object's upper part above which its detailed face shows to the front
+# camera (plain backs measured 1.0-1.9, a board's code and a fan's grille 4.5 and more); the fewest
+# pixels of that upper part the contrast is read from
+FACE_TOL = 0.45
+FACE_ELONGATION = 2.0
+FACE_CONTRAST = 3.0
+FACE_MIN_PX = 30
 COL_MARGIN = 2  # pixels of column separation for left_of / right_of
 NEAR = 0.1  # metres between the centroids for ``near`` (the oracle's distance)
 LIFT_ROWS = 8  # front-view pixel rows (of 240) an object's bottom must rise to count as lifted
@@ -814,6 +825,51 @@ def _lifted(obs: Observation, a: str) -> tuple[bool, str]:
     return True, f"rose by {rise} px"
 
 
+def _facing(obs: Observation, a: str) -> tuple[bool, str]:
+    """``a``'s functional face (a board's printed code, a fan's grille) points at the robot's base.
+
+    The top view gives the face's axis up to its sign: ``a``'s tall part (its pixels at least half
+    its height up: a board's plate, a fan's head) is a flat thing, elongated at least
+    :data:`FACE_ELONGATION` along itself, whose short axis is the face's normal; that axis must
+    point at the robot's base (the view's calibration) within the oracle's :data:`FACE_TOL`. The
+    front view gives the sign: its camera looks at the table from the side opposite the robot, so
+    an object facing the robot shows it its plain back, and the face's printed detail shows as a
+    contrast the back does not have (luminance P90/P10 over the upper part of ``a``'s front-view
+    outline above :data:`FACE_CONTRAST`: the face turned away from the robot).
+    """
+    top, front = obs.after.get(TOP), obs.after.get(FRONT)
+    if top is None or front is None or top.robot_base is None:
+        return False, "the calibrated top view and the front view are needed"
+    heights, mask = _heights(top), _mask(obs, top, a)
+    if heights is None or not mask.any():
+        return False, f"{a} is not visible from the top (or the top view has no depth)"
+    tall = mask & (heights > 0.5 * float(np.percentile(heights[_inner(mask)], 95)))
+    rows, cols = np.nonzero(tall)
+    if len(rows) < 3:
+        return False, f"{a}'s upper part does not show from the top"
+    spread, axes = np.linalg.eigh(np.cov(np.vstack([rows, cols])))
+    if spread[1] < FACE_ELONGATION ** 2 * max(float(spread[0]), 1e-9):
+        return False, f"{a}'s upper part is not flat enough from the top to tell which way it faces"
+    to_robot = np.array(top.robot_base) - [rows.mean(), cols.mean()]
+    off = float(np.arccos(min(1.0, abs(float(axes[:, 0] @ to_robot)) / float(np.linalg.norm(to_robot)))))
+    if off > FACE_TOL:
+        return False, f"{a}'s face is turned {np.degrees(off):.0f} degrees from the robot (from the top)"
+    seen = _mask(obs, front, a)
+    front_rows = rows_of(seen)
+    if front_rows is None:
+        return False, f"{a} is hidden from the front: which of its sides faces the robot cannot be seen"
+    upper = seen.copy()
+    upper[front_rows[0] + int(0.6 * (front_rows[1] - front_rows[0])):] = False
+    if upper.sum() < FACE_MIN_PX:
+        return False, f"too little of {a} shows from the front to tell which of its sides faces the robot"
+    p10, p90 = np.percentile(front.rgb[upper].astype(float).mean(axis=1), [10, 90])
+    contrast = float(p90 / max(p10, 1.0))
+    if contrast > FACE_CONTRAST:
+        return False, (f"{a} shows its face to the front camera (contrast x{contrast:.1f}): it faces away "
+                       "from the robot")
+    return True, f"faces the robot within {np.degrees(off):.0f} degrees, its plain back to the front camera"
+
+
 def _stacked(obs: Observation, *objs: str) -> tuple[bool, str]:
     for lower, upper in zip(objs, objs[1:], strict=False):
         ok, why = _on(obs, upper, lower)
@@ -827,7 +883,7 @@ IMAGE_CHECKS: Registry[ImageCheck] = Registry("image check")
 _checks: dict[str, ImageCheck] = {
     "on": _on, "inside": _inside, "released": _released, "pressed": _pressed, "upright": _upright,
     "on_table": _on_table, "near": _near, "lifted": _lifted, "stacked": _stacked, "opened": _opened,
-    "closed": _closed,
+    "closed": _closed, "facing": _facing,
     "left_of": lambda obs, a, b: _side(obs, a, b, True),
     "right_of": lambda obs, a, b: _side(obs, a, b, False),
 }

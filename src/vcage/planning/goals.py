@@ -69,6 +69,13 @@ def close_drawer(obj: str, text: str) -> Subtask:
                    predicates=(Predicate(name="closed", args=(obj,)),))
 
 
+def turn_to_face(obj: str, text: str) -> Subtask:
+    """``obj`` put back down where it stood, turned so that its functional face points at the robot."""
+    return Subtask(skill="turn_to_face", args={"obj": obj}, description=text,
+                   predicates=(Predicate(name="facing", args=(obj,)), Predicate(name="on_table", args=(obj,)),
+                               Predicate(name="upright", args=(obj,))))
+
+
 def put_at(obj: str, xy: tuple[float, float], text: str, left_of: str | None = None) -> Subtask:
     preds = [Predicate(name="on_table", args=(obj,)), Predicate(name="released", args=(obj,))]
     if left_of is not None:
@@ -274,4 +281,12 @@ GOALS: tuple[Goal, ...] = (
           put_on("yellow", "orange", "the yellow block is stacked on the orange block"),
           put_on("purple", "yellow", "the purple block tops the second three-block building"),
           press("bell", "the bell is rung: the block city is finished"))),
+    Goal("open_the_front_desk",
+         ("open the front desk", "get the reception ready for visitors", "set up the front desk",
+          "prepare the reception desk"),
+         (_obj("board", "qr_board"), _obj("phone", "phone"), _obj("stand", "phone_stand"),
+          _obj("bell", "bell")),
+         (turn_to_face("board", "the QR code board is turned to face the robot, standing on the table"),
+          put_on("phone", "stand", "the phone rests on the phone stand"),
+          press("bell", "the bell is rung: the desk is open"))),
 )

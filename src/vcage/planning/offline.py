@@ -30,7 +30,7 @@ from pydantic import ValidationError
 from vcage.assets.catalog import CATALOG
 from vcage.errors import ConfigError, PlanningError
 from vcage.planning.config import MAX_SUBTASKS
-from vcage.planning.goals import GOALS, Goal, close_drawer, open_drawer, press, put_in, put_on
+from vcage.planning.goals import GOALS, Goal, close_drawer, open_drawer, press, put_in, put_on, turn_to_face
 from vcage.planning.language import Matcher, Scored, bounded, tokens
 from vcage.planning.lexicon import (
     ALIASES,
@@ -69,7 +69,10 @@ _ELIDED = re.compile(rf"^(?P<obj>.+?)\s+(?P<rel>{_REL})\s+(?P<target>.+)$")  # "
 _PRESS = re.compile(rf"^(?P<verb>{_PRESS_VERBS})\s+(?P<obj>.+)$")
 # "close up the office" and "shut down the laptop" are not about a drawer
 _DRAWER = re.compile(rf"^(?P<verb>{_DRAWER_VERBS})\s+(?!(?:up|down|off)\b)(?P<obj>.+)$")
-_COMMAND = re.compile(rf"^(?:{_PLACE_VERBS}|{_PRESS_VERBS}|{_DRAWER_VERBS}|switch|turn)\b")
+# "turn the QR code board to face me": a step of its own, read before the press verbs ("turn on ...")
+_FACE = re.compile(r"^(?:turn|rotate)\s+(?P<obj>.+?)\s+(?:a?round\s+)?(?:to\s+face|towards?)\s+"
+                   r"(?:me|us|the\s+robot)$")
+_COMMAND = re.compile(rf"^(?:{_PLACE_VERBS}|{_PRESS_VERBS}|{_DRAWER_VERBS}|switch|turn|rotate)\b")
 _GERUNDS = {"putting": "put", "placing": "place", "moving": "move", "setting": "set", "dropping": "drop",
             "laying": "lay", "stacking": "stack", "nesting": "nest", "pressing": "press", "pushing": "push",
             "ringing": "ring", "hitting": "hit", "tapping": "tap", "silencing": "silence", "flipping": "flip"}
@@ -291,6 +294,16 @@ class OfflinePlanner:
             if m["verb"] in ("close", "shut"):
                 return close_drawer(o.name, f"the {_words(o)}'s drawer is shut")
             return open_drawer(o.name, f"the {_words(o)}'s drawer is pulled open")
+        m = _FACE.match(clause)
+        if m:
+            ref = parse_phrase(m["obj"], clause)
+            _check_colour(ref, ref.type)
+            o = objects.resolve(ref, ref.type, clause)
+            if CATALOG.get(o.type).face is None:
+                faced = [x.name for x in CATALOG.values() if x.face is not None]
+                raise PlanningError(f"a {o.type.replace('_', ' ')} has no face to turn towards the robot (in "
+                                    f"{bounded(clause)}); objects with one: {', '.join(faced)}")
+            return turn_to_face(o.name, f"the {_words(o)} is turned to face the robot, standing on the table")
         m = _PRESS.match(clause)
         if m:
             ref = parse_phrase(m["obj"], clause)
@@ -313,7 +326,8 @@ class OfflinePlanner:
                 point = fps[0].name
             return press(o.name, f"the {_words(o)} is pressed", point=point)
         raise PlanningError(f"cannot read {bounded(clause)} as a step: a step is 'put/place/move X on/in Y', "
-                            f"'press/ring/flip Z' or 'open/close the drawer', naming catalog objects")
+                            f"'press/ring/flip Z', 'open/close the drawer' or 'turn X to face me', naming "
+                            "catalog objects")
 
     def _understood(self, clauses: list[str], subtasks: list[Subtask]) -> str:
         seen = listed(list(dict.fromkeys(m.label() for m in find_mentions(words(" ; ".join(clauses))))))

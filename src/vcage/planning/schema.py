@@ -145,7 +145,21 @@ class Plan(_Strict):
                     raise ValueError(f"subtask {i} ({st.skill}) names placement {place!r} of {target!r}; "
                                      f"its placements: {valid}")
         self._drawers_open_when_used()
+        self._faces_exist()
         return self
+
+    def _faces_exist(self) -> None:
+        """Only an object with a face (a board's code, a fan's outlet) is turned to face the robot or
+        checked for it: on another, ``facing`` could never hold."""
+        types = {o.name: o.type for o in self.objects}
+        for i, st in enumerate(self.subtasks):
+            named = [st.args.get("obj")] if st.skill == "turn_to_face" else []
+            named += [p.args[0] for p in st.predicates if p.name == "facing" and p.args]
+            for obj in named:
+                if isinstance(obj, str) and obj in types and CATALOG.get(types[obj]).face is None:
+                    faced = [t.name for t in CATALOG.values() if t.face is not None]
+                    raise ValueError(f"subtask {i} ({st.skill}) turns {obj!r}, a {types[obj]}, to face the "
+                                     f"robot, but it has no face to turn; objects with one: {faced}")
 
     def _drawers_open_when_used(self) -> None:
         """Drawers are opened and closed on objects that have one, and something put into a drawer goes

@@ -146,7 +146,13 @@ class Skills:
         return wrap_angle(yaw + k * period)
 
     # -- grasp selection ----------------------------------------------------------------------
-    def grasp_candidates(self, obj: str, name: str | None = None) -> list[GraspChoice]:
+    def grasp_candidates(self, obj: str, name: str | None = None,
+                         then_turn: float = 0.0) -> list[GraspChoice]:
+        """``obj``'s annotated grasps (``name``: that one), each at the hand heading, among its yaw and
+        the yaw half a turn round (the fingers are symmetric), closest to the current heading; for an
+        object the hand will turn by ``then_turn`` while holding it, the heading halfway through that
+        turn is closest (the wrist then starts and ends the turn at most a quarter turn plus half of
+        it away from where it is)."""
         inst = self.world.object(obj)
         otype = CATALOG.get(inst.type_name)
         grasps = [g for g in otype.grasps if name is None or g.name == name]
@@ -160,15 +166,18 @@ class Skills:
         for g in grasps:
             p = pos + rot @ (np.asarray(g.pos) * inst.scale)
             p[2] = max(p[2], self.table_z + TCP_MIN_ABOVE_TABLE)
-            out.append(GraspChoice(obj, g, p, self.natural_yaw(yaw_of(rot) + g.yaw)))
+            yaw = self.natural_yaw(yaw_of(rot) + g.yaw + then_turn / 2) - then_turn / 2
+            out.append(GraspChoice(obj, g, p, yaw))
         _, current = self.tcp()
         out.sort(key=lambda c: abs(wrap_angle(c.yaw - current)))
         return out
 
-    def choose_grasp(self, obj: str, name: str | None = None) -> tuple[GraspChoice, list[Waypoint]]:
-        """The first annotated grasp whose approach and grasp poses are reachable, with its plan."""
+    def choose_grasp(self, obj: str, name: str | None = None,
+                     then_turn: float = 0.0) -> tuple[GraspChoice, list[Waypoint]]:
+        """The first annotated grasp whose approach and grasp poses are reachable, with its plan
+        (``then_turn``: see :meth:`grasp_candidates`)."""
         errors = []
-        for cand in self.grasp_candidates(obj, name):
+        for cand in self.grasp_candidates(obj, name, then_turn):
             try:
                 pre = cand.pos + [0.0, 0.0, APPROACH]
                 wps = self.transit(self.q, pre, cand.yaw, OPEN)

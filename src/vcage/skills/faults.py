@@ -40,7 +40,16 @@ from vcage.skills.base import (
 )
 from vcage.skills.drawers import goal_opening, opening, slide
 from vcage.skills.motion import MotionPlan, Waypoint
-from vcage.skills.primitives import lift, move_line, placement_target, press, push, shake, turn_and_place
+from vcage.skills.primitives import (
+    lift,
+    move_line,
+    placement_target,
+    press,
+    push,
+    shake,
+    turn_and_place,
+    turned_to_face,
+)
 
 Args = Mapping[str, Any]
 Perturb = Callable[[Skills, str, Args, np.random.Generator], MotionPlan | None]
@@ -310,9 +319,13 @@ def _press_miss(s: Skills, skill: str, args: Args, rng: np.random.Generator) -> 
 
 # -- turn_and_place, move_line, shake --------------------------------------------------------------
 
-@_fault("turn_short", ("turn_and_place",), "put the object down turned only 30-60% of the angle asked")
+@_fault("turn_short", ("turn_and_place", "turn_to_face"), "put the object down turned only 30-60% of the "
+        "angle asked (or needed to face the robot)")
 def _turn_short(s: Skills, skill: str, args: Args, rng: np.random.Generator) -> MotionPlan:
-    return turn_and_place(s, **{**args, "turn": float(args["turn"]) * rng.uniform(0.3, 0.6)})
+    share = rng.uniform(0.3, 0.6)
+    if skill == "turn_to_face":
+        return turned_to_face(s, **{**args, "share": share})
+    return turn_and_place(s, **{**args, "turn": float(args["turn"]) * share})
 
 
 @_fault("stop_short", ("move_line",), "stop 40-70% of the way along the line (a strike, pull or slide "

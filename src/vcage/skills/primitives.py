@@ -11,8 +11,10 @@ import numpy as np
 
 from vcage.assets.catalog import CATALOG
 from vcage.errors import SkillError
-from vcage.geometry import rot_z, wrap_half_turn, yaw_of
+from vcage.geometry import rot_z, wrap_angle, wrap_half_turn, yaw_of
+from vcage.scene.spec import ROBOT_MOUNT
 from vcage.sim.robot import HOME_QPOS
+from vcage.sim.world import World
 from vcage.skills.base import (
     APPROACH,
     CART_SPEED,
@@ -30,6 +32,7 @@ from vcage.skills.motion import MotionPlan, Waypoint
 from vcage.skills.placements import placement_frame
 
 PLACE_CLEARANCE = 0.012  # metres above its resting height at which a placed object is let go
+FACE_LIFT = 0.05  # metres turn_to_face lifts an object before turning it (as rotate_qrcode's expert did)
 ELONGATED = 1.15  # long side over short side from which an object or a container's room has a long axis
 
 
@@ -236,9 +239,10 @@ def rotate(s: Skills, angle: float) -> MotionPlan:
 @SKILLS.register("turn_and_place")
 def turn_and_place(s: Skills, obj: str, turn: float, target: str | None = None,
                    placement: str | None = None, xy: tuple[float, float] | None = None,
-                   clearance: float = PLACE_CLEARANCE) -> MotionPlan:
+                   clearance: float = PLACE_CLEARANCE, offset: np.ndarray | None = None) -> MotionPlan:
     """Put the held ``obj`` down like :func:`place`, turned by ``turn`` radians about the vertical
-    (the hand turns by exactly that much, so the object's heading changes by ``turn``)."""
+    (the hand turns by exactly that much, so the object's heading changes by ``turn``). ``offset``
+    is the object origin relative to the TCP; measured from the world when not given."""
     if target is not None:
         surface, _ = placement_target(s, target, placement)
     elif xy is not None:
@@ -246,9 +250,57 @@ def turn_and_place(s: Skills, obj: str, turn: float, target: str | None = None,
     else:
         raise SkillError("turn_and_place needs a target object or a table position xy")
     _, hand_yaw = s.tcp()
-    offset = rot_z(turn) @ _held_offset(s, obj)  # the object turns about the TCP with the hand
+    held = _held_offset(s, obj) if offset is None else np.asarray(offset)
+    turned = rot_z(turn) @ held  # the object turns about the TCP with the hand
     return MotionPlan("turn_and_place",
-                      _lower_and_release(s, surface, offset, hand_yaw + turn, clearance).waypoints)
+                      _lower_and_release(s, surface, turned, hand_yaw + turn, clearance).waypoints)
+
+
+def turn_to_face_robot(world: World, obj: str, at: tuple[float, float] | None = None,
+                       point: str | None = None) -> float:
+    """The turn (within ±pi) after which ``obj``'s functional point faces the robot's base, once
+    ``obj`` stands at ``at`` (default: where it is)."""
+    d = CATALOG.get(world.object(obj).type_name).functional_point(point).direction
+    out = math.atan2(d[1], d[0]) + yaw_of(world.object_mat(obj))
+    pos = world.object_pos(obj) if at is None else at
+    wanted = math.atan2(ROBOT_MOUNT[1] - pos[1], ROBOT_MOUNT[0] - pos[0])
+    return wrap_angle(wanted - out)
+
+
+@SKILLS.register("turn_to_face")
+def turn_to_face(s: Skills, obj: str, target: str | None = None, placement: str | None = None,
+                 xy: tuple[float, float] | None = None, point: str | None = None,
+                 grasp_name: str | None = None) -> MotionPlan:
+    """Grasp ``obj``, lift it and put it down turned so that its functional point (``point``: its
+    first) faces the robot: on ``target``'s placement, on the table at ``xy``, or where it stood."""
+    return turned_to_face(s, obj, target, placement, xy, point, grasp_name)
+
+
+def turned_to_face(s: Skills, obj: str, target: str | None = None, placement: str | None = None,
+                   xy: tuple[float, float] | None = None, point: str | None = None,
+                   grasp_name: str | None = None, share: float = 1.0) -> MotionPlan:
+    """:func:`turn_to_face`, turning ``share`` of the turn it needs (1: all of it)."""
+    if point is None:
+        face = CATALOG.get(s.world.object(obj).type_name).face
+        if face is None:
+            raise SkillError(f"{obj} ({s.world.object(obj).type_name}) has no face to turn towards the robot")
+        point = face.name
+    if target is not None:
+        at = tuple(placement_target(s, target, placement)[0][:2])
+    else:
+        here = s.world.object_pos(obj)
+        at = (float(here[0]), float(here[1])) if xy is None else (float(xy[0]), float(xy[1]))
+    turn = share * turn_to_face_robot(s.world, obj, (at[0], at[1]), point)
+    choice, wps = s.choose_grasp(obj, grasp_name, then_turn=turn)  # the wrist turns about its heading now
+    wps.append(Waypoint(wps[-1].q, CLOSED, 0.3, hold=0.5, label="close"))
+    plan = MotionPlan("turn_to_face", tuple(wps))
+    offset = s.world.object_pos(obj) - choice.pos  # where the object will sit relative to the TCP
+    with s.after(plan):
+        plan = plan + lift(s, height=FACE_LIFT)
+    with s.after(plan):
+        plan = plan + turn_and_place(s, obj, turn, target, placement,
+                                     None if target is not None else (at[0], at[1]), offset=offset)
+    return MotionPlan("turn_to_face", plan.waypoints)
 
 
 @SKILLS.register("move_line")

@@ -181,10 +181,13 @@ def moved(world: World, obj: str, start_xy: np.ndarray, distance: float) -> bool
 
 
 def facing(world: World, obj: str, point: str | None = None, tol: float = 0.45) -> bool:
-    """``obj``'s functional point faces the robot: its outward ``direction``, turned with the
-    object, points at the robot's base within ``tol`` radians (in the horizontal plane)."""
-    inst = world.object(obj)
-    fp = CATALOG.get(inst.type_name).functional_point(point)
+    """``obj``'s functional point (``point``; None: its face, see ``ObjectType.face``) faces the
+    robot: its outward ``direction``, turned with the object, points at the robot's base within
+    ``tol`` radians (in the horizontal plane). An object without a face faces nowhere."""
+    otype = CATALOG.get(world.object(obj).type_name)
+    fp = otype.face if point is None else otype.functional_point(point)
+    if fp is None:
+        return False
     out = (world.object_mat(obj) @ np.asarray(fp.direction, float))[:2]
     to_robot = np.asarray(ROBOT_MOUNT[:2]) - world.object_pos(obj)[:2]
     if np.linalg.norm(out) < 1e-6:
@@ -209,3 +212,4 @@ ORACLE_CHECKS.add("released", lambda w, a: not grasped(w, a))
 ORACLE_CHECKS.add("pressed", lambda w, a: pressed(w, a))  # an event: the oracle latches it
 ORACLE_CHECKS.add("opened", lambda w, a: opened(w, a))
 ORACLE_CHECKS.add("closed", lambda w, a: closed(w, a))
+ORACLE_CHECKS.add("facing", lambda w, a: facing(w, a))

@@ -2,14 +2,11 @@
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
 from vcage.assets.catalog import CATALOG
-from vcage.geometry import wrap_angle
-from vcage.scene.spec import ROBOT_MOUNT
 from vcage.sim.world import World
+from vcage.skills.primitives import turn_to_face_robot
 from vcage.tasks.templates import heading, turn_to_align
 
 __all__ = ["heading", "local_xy", "top_of", "turn_to_align", "turn_to_face_robot"]
@@ -20,18 +17,6 @@ def local_xy(world: World, host: str, local: tuple[float, float]) -> tuple[float
     inst = world.object(host)
     p = world.object_pos(host) + world.object_mat(host) @ (np.array([*local, 0.0]) * inst.scale)
     return float(p[0]), float(p[1])
-
-
-def turn_to_face_robot(world: World, obj: str, at: tuple[float, float] | None = None,
-                       point: str | None = None) -> float:
-    """The turn (within ±pi) after which ``obj``'s functional point faces the robot's base, once
-    ``obj`` stands at ``at`` (default: where it is)."""
-    inst = world.object(obj)
-    d = CATALOG.get(inst.type_name).functional_point(point).direction
-    out = math.atan2(d[1], d[0]) + heading(world, obj)
-    pos = world.object_pos(obj) if at is None else at
-    wanted = math.atan2(ROBOT_MOUNT[1] - pos[1], ROBOT_MOUNT[0] - pos[0])
-    return wrap_angle(wanted - out)
 
 
 def top_of(world: World, obj: str) -> float:
