@@ -6,10 +6,9 @@ import numpy as np
 
 from vcage.assets.catalog import CATALOG
 from vcage.sim.world import World
-from vcage.skills.primitives import turn_to_face_robot
 from vcage.tasks.templates import heading, turn_to_align
 
-__all__ = ["heading", "local_xy", "top_of", "turn_to_align", "turn_to_face_robot"]
+__all__ = ["heading", "local_xy", "top_of", "turn_to_align"]
 
 
 def local_xy(world: World, host: str, local: tuple[float, float]) -> tuple[float, float]:

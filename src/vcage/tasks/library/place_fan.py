@@ -9,7 +9,6 @@ from vcage.sim.world import World
 from vcage.skills.base import Skills
 from vcage.tasks import predicates as P
 from vcage.tasks.base import TASKS, Item
-from vcage.tasks.library._support import turn_to_face_robot
 from vcage.tasks.templates import PlaceTask
 
 
@@ -21,11 +20,7 @@ class PlaceFan(PlaceTask):
     obj, target, need_upright = "fan", "mat", True
 
     def expert(self, skills: Skills) -> None:
-        skills.do("grasp", obj="fan")
-        skills.do("lift")
-        at = skills.world.object_pos("mat")[:2]
-        skills.do("turn_and_place", obj="fan", target="mat",
-                  turn=turn_to_face_robot(skills.world, "fan", at=(float(at[0]), float(at[1]))))
+        skills.do("turn_to_face", obj="fan", target="mat")
         skills.do("retreat")
 
     def evaluate(self, world: World) -> dict[str, Any]:

@@ -9,7 +9,6 @@ from vcage.sim.world import World
 from vcage.skills.base import Skills
 from vcage.tasks import predicates as P
 from vcage.tasks.base import TASKS, AtomicTask, Item
-from vcage.tasks.library._support import turn_to_face_robot
 
 
 @TASKS.register("rotate_qrcode")
@@ -21,12 +20,7 @@ class RotateQrcode(AtomicTask):
         return {"color": self.color_of("board")}
 
     def expert(self, skills: Skills) -> None:
-        world = skills.world
-        xy = world.object_pos("board")[:2].copy()
-        skills.do("grasp", obj="board")
-        skills.do("lift", height=0.05)
-        skills.do("turn_and_place", obj="board", turn=turn_to_face_robot(world, "board"),
-                  xy=(float(xy[0]), float(xy[1])))
+        skills.do("turn_to_face", obj="board")  # put back where it stood
         skills.do("retreat")
 
     def evaluate(self, world: World) -> dict[str, Any]:
