@@ -87,6 +87,8 @@ def canonical(plan: Plan) -> list[list[str]]:
         elif st.skill == "pick_and_place" and "target" in st.args:
             rel = next((p.name for p in st.predicates if p.name in ("on", "inside")), "?")
             steps.append(["in" if rel == "inside" else rel, obj, names.get(str(st.args["target"]), "?")])
+        elif st.skill == "hang":
+            steps.append(["hang", obj, names.get(str(st.args.get("target")), "?")])
         else:
             steps.append([st.skill, obj])
     return steps
@@ -105,7 +107,7 @@ def judge(case: Case, plan: Plan) -> tuple[bool, str]:
         return ok, got + (f" without {missing}" if missing else "")
     want = case.expect["subtasks"]
     steps = canonical(plan)
-    used = {s[1] for s in want} | {s[2] for s in want if s[0] in ("on", "in")}
+    used = {s[1] for s in want} | {s[2] for s in want if s[0] in ("on", "in", "hang")}
     extra = set(descriptors(plan).values()) - used
     ok = goal is None and steps == want and not extra
     return ok, got + (f" with extra objects {sorted(extra)}" if extra else "")

@@ -172,3 +172,24 @@ def test_turn_to_face_puts_a_board_down_where_it_stood_facing_the_robot(xy: tupl
     world.settle(0.5)
     assert P.facing(world, "board") and P.upright(world, "board") and P.on_table(world, "board")
     assert np.linalg.norm(world.object_pos("board")[:2] - np.asarray(xy)) < 0.03
+
+
+@pytest.mark.parametrize(("mug", "rack_yaw"), [((0.45, -0.12), 0.0), ((0.42, 0.2), -0.6), ((0.5, -0.2), 0.5)])
+def test_hang_threads_the_mugs_handle_onto_the_racks_peg(mug: tuple[float, float], rack_yaw: float) -> None:
+    """The mug turns so that the peg runs through its handle, whichever way the rack stands; what has
+    no loop, or no hook, is a typed error naming what has one."""
+    from vcage.scene.compose import compose
+    from vcage.scene.spec import ObjectSpec, SceneSpec
+
+    world = compose(SceneSpec(objects=(ObjectSpec("mug", "mug", mug),
+                                       ObjectSpec("rack", "mug_rack", (0.63, 0.05), yaw=rack_yaw),
+                                       ObjectSpec("bell", "bell", (0.4, -0.25))))).make_world()
+    world.settle(0.3)
+    skills = Skills(world)
+    with pytest.raises(SkillError, match="'bell' \\(bell\\) has no loop; objects with one: \\['mug'\\]"):
+        skills.do("hang", obj="bell", target="rack")
+    with pytest.raises(SkillError, match="'bell' \\(bell\\) has no hook; objects with one: \\['mug_rack'\\]"):
+        skills.do("hang", obj="mug", target="bell")
+    skills.do("hang", obj="mug", target="rack")
+    world.settle(0.5)
+    assert P.hanging(world, "mug", "rack") and not P.grasped(world, "mug")

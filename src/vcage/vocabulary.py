@@ -59,6 +59,7 @@ _predicate("released", 1, 1, "the hand no longer holds the object")
 _predicate("pressed", 1, 1, "the object's button or lever was pressed during the subtask", Kind.EVENT)
 _predicate("opened", 1, 1, "the object's drawer is pulled out at least as far as counts as open")
 _predicate("closed", 1, 1, "the object's drawer is pushed shut")
+_predicate("hanging", 2, 2, "the first object hangs from the second (on its hook), clear of the table")
 _predicate("facing", 1, 1, "the object's functional face (a board's code, a fan's front) points at the robot")
 
 
@@ -126,6 +127,8 @@ _skill("open_gripper", "Open the hand fully where it is.")
 _skill("open_drawer", "Pull ``obj``'s drawer out by its handle to ``distance`` metres (default: the "
        "handle's stroke).", _obj("obj"), _opt("point"), _opt("distance"))
 _skill("close_drawer", "Push ``obj``'s drawer shut by its handle.", _obj("obj"), _opt("point"))
+_skill("hang", "Hang ``obj`` by its loop (a mug's handle) on ``target``'s hook (a rack's peg): grasp, lift, "
+       "turn, thread the loop onto the hook, let go.", _obj("obj"), _obj("target"), _opt("point"))
 _skill("turn_to_face", "Grasp ``obj``, lift it and put it down turned so that its functional face points at "
        "the robot: on ``target``, on the table at ``xy``, or where it stood.", _obj("obj"),
        _obj("target", False), _opt("placement"), _opt("xy"), _opt("point"), _opt("grasp_name"))

@@ -17,7 +17,7 @@ from critics.faulted import Run, run
 from vcage.critics.base import Verdict
 from vcage.critics.image import ROBOT, ImageCritic
 from vcage.critics.masks import touch
-from vcage.planning.goals import close_drawer, open_drawer, press, put_in, put_on, turn_to_face
+from vcage.planning.goals import close_drawer, hang, open_drawer, press, put_in, put_on, turn_to_face
 from vcage.planning.schema import Predicate, Subtask
 from vcage.scene.compose import compose
 from vcage.scene.spec import ObjectSpec as O
@@ -46,6 +46,7 @@ ROW_LEFT = (O("a", "block", (0.5, -0.1)), O("b", "block", (0.55, 0.05)))
 ROW_RIGHT = (O("a", "block", (0.5, 0.1)), O("b", "block", (0.55, -0.05)))
 CABINET = (O("cab", "cabinet", (0.68, 0.05), yaw=-0.2),)
 BOARD_AWAY = (O("board", "qr_board", (0.55, 0.1)),)  # its code faces +x, away from the robot
+MUG_RACK = (O("mug", "mug", (0.45, -0.12)), O("rack", "mug_rack", (0.63, 0.08)))
 BOARD_SIDEWAYS = (O("board", "qr_board", (0.55, 0.0), yaw=np.pi / 2),)  # its code faces the robot's left
 
 SCENARIOS: dict[str, tuple[tuple[O, ...], Subtask]] = {
@@ -73,6 +74,7 @@ SCENARIOS: dict[str, tuple[tuple[O, ...], Subtask]] = {
     "inside_drawer": ((*CABINET, O("soap", "soap", (0.5, -0.15))),
                       put_in("soap", "cab", "the soap is in the open drawer")),  # after opening it
     "facing": (BOARD_SIDEWAYS, turn_to_face("board", "the board faces the robot")),
+    "hanging": (MUG_RACK, hang("mug", "rack", "the mug hangs on the rack")),
 }
 BEFORE = {"closed": (open_drawer("cab", "the drawer is open"),),
           "inside_drawer": (open_drawer("cab", "the drawer is open"),)}
@@ -108,6 +110,7 @@ FAILURES = [
     # turned 30-60% of the quarter turn it needed: its plain back shows obliquely to the front camera,
     # as it does when the board faces the robot; only its axis from the top tells
     ("facing", "turn_short", 0, "facing(board)"),
+    ("hanging", "hang_short", 0, "hanging(mug, rack)"),  # let go beside the peg's end: it falls on the base
 ]
 
 
@@ -371,6 +374,17 @@ def test_a_board_put_back_with_its_code_away_from_the_robot_does_not_face_it() -
     verdict = CRITIC.judge(result.obs)
     assert verdict.details["checks"] == {"facing(board)": False, "released(board)": True}, verdict.reason
     assert "faces away from the robot" in verdict.reason
+
+
+def test_a_mug_hung_on_one_rack_does_not_hang_from_the_other() -> None:
+    """High above the table, as hanging makes it, but on the wrong rack: it touches only that one."""
+    racks = (*MUG_RACK, O("other", "mug_rack", (0.45, 0.25)))
+    result = run(racks, _sub("hang", {"obj": "mug", "target": "rack"},
+                             ("hanging", ("mug", "other")), ("released", ("mug",))))
+    assert result.outcome.oracle == {"hanging(mug, other)": False, "released(mug)": True}
+    verdict = CRITIC.judge(result.obs)
+    assert verdict.details["checks"]["hanging(mug, other)"] is False, verdict.reason
+    assert "does not touch other" in verdict.reason
 
 
 def test_the_checks_under_test_cover_every_image_check() -> None:

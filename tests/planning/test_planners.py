@@ -144,6 +144,20 @@ def test_plan_schema_refuses_to_turn_an_object_without_a_face_towards_the_robot(
         Plan.model_validate(bell_checked)
 
 
+def test_plan_schema_refuses_to_hang_what_has_no_loop_or_on_what_has_no_hook() -> None:
+    corner = next(g for g in GOALS if g.name == "tidy_the_coffee_corner").plan("tidy the coffee corner")
+    dumped = corner.model_dump()
+    Plan.model_validate(dumped)  # the mug's handle on the rack's peg
+    cup_hung = json.loads(json.dumps(dumped))
+    cup_hung["subtasks"][0]["args"]["obj"] = "cup"
+    with pytest.raises(ValueError, match="hangs 'cup' on 'rack', but 'cup', a cup, has no loop"):
+        Plan.model_validate(cup_hung)
+    on_bell = json.loads(json.dumps(dumped))
+    on_bell["subtasks"][0]["predicates"][0]["args"] = ["mug", "bell"]
+    with pytest.raises(ValueError, match="'bell', a bell, has no hook; objects with one: \\['mug_rack'\\]"):
+        Plan.model_validate(on_bell)
+
+
 # -- LLM planner against a local OpenAI-protocol server ------------------------------------------
 
 @pytest.fixture()

@@ -242,3 +242,22 @@ def test_what_lies_in_an_open_drawer_is_inside_it_and_comes_back_in_with_it() ->
     assert _value(world, "inside", "soap", "cab")
     skills.do("close_drawer", obj="cab")
     assert _value(world, "inside", "soap", "cab") and _value(world, "closed", "cab")
+
+
+def test_a_mug_lying_on_its_side_on_a_racks_base_does_not_hang_from_it() -> None:
+    """It touches the rack and its origin (the centre of its base) stands 5 cm up, as a hanging mug's
+    does; its lowest point lies on the rack's base plate. Hung by the skill, it hangs."""
+    from vcage.tasks import predicates as P
+
+    world = _composed(ObjectSpec("rack", "mug_rack", (0.6, 0.1)), ObjectSpec("mug", "mug", (0.45, -0.15)))
+    adr = int(world.model.jnt_qposadr[world.model.joint("mug/free").id])
+    side = [np.cos(np.pi / 4), 0.0, np.sin(np.pi / 4), 0.0]  # its axis along +x: lying on its side
+    world.data.qpos[adr:adr + 7] = [0.56, 0.07, world.table_top() + 0.012 + 0.042, *side]
+    world.forward()
+    world.settle(0.5)
+    assert P.contact_between(world, "mug", "rack") and P.lifted(world, "mug")
+    assert not _value(world, "hanging", "mug", "rack")
+    world = _settled(ObjectSpec("mug", "mug", (0.45, -0.12)), ObjectSpec("rack", "mug_rack", (0.63, 0.08)))
+    Skills(world).do("hang", obj="mug", target="rack")
+    world.settle(0.5)
+    assert _value(world, "hanging", "mug", "rack")

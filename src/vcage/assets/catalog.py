@@ -72,6 +72,10 @@ class ObjectType:
         return next((p for p in self.functional_points
                      if p.kind in FACE_KINDS and abs(p.direction[2]) < 0.5), None)
 
+    def point_of_kind(self, kind: str, name: str | None = None) -> FunctionalPoint | None:
+        """Its first functional point of ``kind`` (``name``: the one of that name); None if none."""
+        return next((p for p in self.functional_points if p.kind == kind and name in (None, p.name)), None)
+
     @property
     def drawer_handles(self) -> tuple[FunctionalPoint, ...]:
         """The handles of its drawers: functional points of kind ``handle`` on a joint."""

@@ -40,6 +40,8 @@ simulator state. Each predicate is checked in image space:
 - ``upright(x)``: ``x``'s top-view area (orthographic, so true to size wherever it stands) and the
   spread of its outline are close to what they were before, allowing for what the robot can hide;
   its highest point (the top view's depth; without it, its front-view height) did not drop.
+- ``hanging(a, b)``: from the top view, ``a``'s highest point stands higher than ``a`` reaches
+  resting any way up (its longest side, at its type's largest scale) and ``a`` touches ``b``.
 - ``facing(x)``: the short axis of ``x``'s tall part from the top (a board's plate, a fan's head)
   points at the robot's base, whose pixel the top view carries (its calibration), and the front
   camera, opposite the robot, sees the plain back rather than the detailed face (its contrast).
@@ -138,6 +140,9 @@ FACE_TOL = 0.45
 FACE_ELONGATION = 2.0
 FACE_CONTRAST = 3.0
 FACE_MIN_PX = 30
+# hanging: metres above its longest side (largest scale) an object's top must stand to hang (a mug on
+# the rack's peg measured 2.4 cm above; fallen onto the rack's base, 4 cm below)
+HANG_CLEAR = 0.01
 COL_MARGIN = 2  # pixels of column separation for left_of / right_of
 NEAR = 0.1  # metres between the centroids for ``near`` (the oracle's distance)
 LIFT_ROWS = 8  # front-view pixel rows (of 240) an object's bottom must rise to count as lifted
@@ -870,6 +875,28 @@ def _facing(obs: Observation, a: str) -> tuple[bool, str]:
     return True, f"faces the robot within {np.degrees(off):.0f} degrees, its plain back to the front camera"
 
 
+def _hanging(obs: Observation, a: str, b: str) -> tuple[bool, str]:
+    """``a`` hangs from ``b``: from the top view, ``a``'s highest point stands more than
+    :data:`HANG_CLEAR` above its longest side at its type's largest scale (higher than ``a`` reaches
+    resting on the table, any way up, or on ``b``'s base), and its outline touches ``b``'s (what holds
+    it up is ``b``: a mug's handle lies over the rack's peg)."""
+    top = obs.after.get(TOP)
+    heights = _heights(top) if top is not None else None
+    reach = _max_height(obs, a, any_way_up=True)
+    if top is None or heights is None or reach is None:
+        return False, "the top view's heights and the object's type are needed"
+    ma, mb = _mask(obs, top, a), _mask(obs, top, b)
+    if not ma.any() or not mb.any():
+        return False, f"{a} or {b} is not visible from the top"
+    high = float(np.percentile(heights[_inner(ma)], 95))
+    if high < reach + HANG_CLEAR:
+        return False, (f"{a}'s top is {100 * high:.1f} cm above the table, no higher than it reaches "
+                       f"resting any way up ({100 * reach:.1f} cm): it does not hang")
+    if not touch(ma, mb):
+        return False, f"{a} does not touch {b} from the top: it does not hang from it"
+    return True, f"{a}'s top is {100 * high:.1f} cm above the table, touching {b}"
+
+
 def _stacked(obs: Observation, *objs: str) -> tuple[bool, str]:
     for lower, upper in zip(objs, objs[1:], strict=False):
         ok, why = _on(obs, upper, lower)
@@ -883,7 +910,7 @@ IMAGE_CHECKS: Registry[ImageCheck] = Registry("image check")
 _checks: dict[str, ImageCheck] = {
     "on": _on, "inside": _inside, "released": _released, "pressed": _pressed, "upright": _upright,
     "on_table": _on_table, "near": _near, "lifted": _lifted, "stacked": _stacked, "opened": _opened,
-    "closed": _closed, "facing": _facing,
+    "closed": _closed, "facing": _facing, "hanging": _hanging,
     "left_of": lambda obs, a, b: _side(obs, a, b, True),
     "right_of": lambda obs, a, b: _side(obs, a, b, False),
 }

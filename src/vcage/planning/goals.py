@@ -76,6 +76,13 @@ def turn_to_face(obj: str, text: str) -> Subtask:
                                Predicate(name="upright", args=(obj,))))
 
 
+def hang(obj: str, target: str, text: str) -> Subtask:
+    """``obj`` hung by its loop on ``target``'s hook, and let go."""
+    return Subtask(skill="hang", args={"obj": obj, "target": target}, description=text,
+                   predicates=(Predicate(name="hanging", args=(obj, target)),
+                               Predicate(name="released", args=(obj,))))
+
+
 def put_at(obj: str, xy: tuple[float, float], text: str, left_of: str | None = None) -> Subtask:
     preds = [Predicate(name="on_table", args=(obj,)), Predicate(name="released", args=(obj,))]
     if left_of is not None:
@@ -289,4 +296,12 @@ GOALS: tuple[Goal, ...] = (
          (turn_to_face("board", "the QR code board is turned to face the robot, standing on the table"),
           put_on("phone", "stand", "the phone rests on the phone stand"),
           press("bell", "the bell is rung: the desk is open"))),
+    Goal("tidy_the_coffee_corner",
+         ("tidy the coffee corner", "clear up the coffee station", "put the coffee things away",
+          "tidy up after coffee"),
+         (_obj("mug", "mug"), _obj("rack", "mug_rack"), _obj("cup", "cup"), _obj("coaster", "coaster"),
+          _obj("bell", "bell")),
+         (hang("mug", "rack", "the mug hangs on the rack's peg by its handle"),
+          put_on("cup", "coaster", "the cup stands on the coaster"),
+          press("bell", "the bell is rung: the coffee corner is tidy"))),
 )

@@ -30,7 +30,17 @@ from pydantic import ValidationError
 from vcage.assets.catalog import CATALOG
 from vcage.errors import ConfigError, PlanningError
 from vcage.planning.config import MAX_SUBTASKS
-from vcage.planning.goals import GOALS, Goal, close_drawer, open_drawer, press, put_in, put_on, turn_to_face
+from vcage.planning.goals import (
+    GOALS,
+    Goal,
+    close_drawer,
+    hang,
+    open_drawer,
+    press,
+    put_in,
+    put_on,
+    turn_to_face,
+)
 from vcage.planning.language import Matcher, Scored, bounded, tokens
 from vcage.planning.lexicon import (
     ALIASES,
@@ -72,7 +82,8 @@ _DRAWER = re.compile(rf"^(?P<verb>{_DRAWER_VERBS})\s+(?!(?:up|down|off)\b)(?P<ob
 # "turn the QR code board to face me": a step of its own, read before the press verbs ("turn on ...")
 _FACE = re.compile(r"^(?:turn|rotate)\s+(?P<obj>.+?)\s+(?:a?round\s+)?(?:to\s+face|towards?)\s+"
                    r"(?:me|us|the\s+robot)$")
-_COMMAND = re.compile(rf"^(?:{_PLACE_VERBS}|{_PRESS_VERBS}|{_DRAWER_VERBS}|switch|turn|rotate)\b")
+_HANG = re.compile(r"^hang\s+(?P<obj>.+?)\s+(?:up\s+)?(?:on|onto|from)\s+(?P<target>.+)$")
+_COMMAND = re.compile(rf"^(?:{_PLACE_VERBS}|{_PRESS_VERBS}|{_DRAWER_VERBS}|switch|turn|rotate|hang)\b")
 _GERUNDS = {"putting": "put", "placing": "place", "moving": "move", "setting": "set", "dropping": "drop",
             "laying": "lay", "stacking": "stack", "nesting": "nest", "pressing": "press", "pushing": "push",
             "ringing": "ring", "hitting": "hit", "tapping": "tap", "silencing": "silence", "flipping": "flip"}
@@ -294,6 +305,18 @@ class OfflinePlanner:
             if m["verb"] in ("close", "shut"):
                 return close_drawer(o.name, f"the {_words(o)}'s drawer is shut")
             return open_drawer(o.name, f"the {_words(o)}'s drawer is pulled open")
+        m = _HANG.match(clause)
+        if m:
+            o_ref, t_ref = parse_phrase(m["obj"], clause), parse_phrase(m["target"], clause)
+            _check_colour(o_ref, o_ref.type)
+            _check_colour(t_ref, t_ref.type)
+            o, t = objects.resolve(o_ref, o_ref.type, clause), objects.resolve(t_ref, t_ref.type, clause)
+            for x, kind, what in ((o, "loop", "hung up"), (t, "hook", "hung from")):
+                if CATALOG.get(x.type).point_of_kind(kind) is None:
+                    having = [y.name for y in CATALOG.values() if y.point_of_kind(kind) is not None]
+                    raise PlanningError(f"a {x.type.replace('_', ' ')} has no {kind} to be {what} (in "
+                                        f"{bounded(clause)}); objects with one: {', '.join(having)}")
+            return hang(o.name, t.name, f"the {_words(o)} hangs on the {_words(t)}")
         m = _FACE.match(clause)
         if m:
             ref = parse_phrase(m["obj"], clause)
@@ -326,8 +349,8 @@ class OfflinePlanner:
                 point = fps[0].name
             return press(o.name, f"the {_words(o)} is pressed", point=point)
         raise PlanningError(f"cannot read {bounded(clause)} as a step: a step is 'put/place/move X on/in Y', "
-                            f"'press/ring/flip Z', 'open/close the drawer' or 'turn X to face me', naming "
-                            "catalog objects")
+                            "'press/ring/flip Z', 'open/close the drawer', 'hang X on Y' or 'turn X to face "
+                            "me', naming catalog objects")
 
     def _understood(self, clauses: list[str], subtasks: list[Subtask]) -> str:
         seen = listed(list(dict.fromkeys(m.label() for m in find_mentions(words(" ; ".join(clauses))))))

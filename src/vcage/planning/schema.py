@@ -146,7 +146,26 @@ class Plan(_Strict):
                                      f"its placements: {valid}")
         self._drawers_open_when_used()
         self._faces_exist()
+        self._loops_and_hooks_exist()
         return self
+
+    def _loops_and_hooks_exist(self) -> None:
+        """Only an object with a loop (a mug's handle) is hung, and only on one with a hook (a rack's
+        peg): elsewhere ``hanging`` could never hold."""
+        types = {o.name: o.type for o in self.objects}
+        for i, st in enumerate(self.subtasks):
+            pairs: list[tuple[object, object]] = [(st.args.get("obj"), st.args.get("target"))] \
+                if st.skill == "hang" else []
+            pairs += [(p.args[0], p.args[1]) for p in st.predicates
+                      if p.name == "hanging" and len(p.args) == 2]
+            for obj, host in pairs:
+                for name, kind in ((obj, "loop"), (host, "hook")):
+                    if not isinstance(name, str) or name not in types \
+                            or CATALOG.get(types[name]).point_of_kind(kind) is not None:
+                        continue
+                    having = [t.name for t in CATALOG.values() if t.point_of_kind(kind) is not None]
+                    raise ValueError(f"subtask {i} ({st.skill}) hangs {obj!r} on {host!r}, but {name!r}, "
+                                     f"a {types[name]}, has no {kind}; objects with one: {having}")
 
     def _faces_exist(self) -> None:
         """Only an object with a face (a board's code, a fan's outlet) is turned to face the robot or

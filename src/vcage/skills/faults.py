@@ -39,6 +39,7 @@ from vcage.skills.base import (
     Skills,
 )
 from vcage.skills.drawers import goal_opening, opening, slide
+from vcage.skills.hanging import hung
 from vcage.skills.motion import MotionPlan, Waypoint
 from vcage.skills.primitives import (
     lift,
@@ -326,6 +327,12 @@ def _turn_short(s: Skills, skill: str, args: Args, rng: np.random.Generator) -> 
     if skill == "turn_to_face":
         return turned_to_face(s, **{**args, "share": share})
     return turn_and_place(s, **{**args, "turn": float(args["turn"]) * share})
+
+
+@_fault("hang_short", ("hang",), "thread the loop only 20-50% of the way onto the hook before lowering and "
+        "letting go: it comes down beside the hook's end")
+def _hang_short(s: Skills, skill: str, args: Args, rng: np.random.Generator) -> MotionPlan:
+    return hung(s, **{**args, "thread": rng.uniform(0.2, 0.5)})
 
 
 @_fault("stop_short", ("move_line",), "stop 40-70% of the way along the line (a strike, pull or slide "

@@ -23,6 +23,7 @@ XY_TOL = 0.01  # slack beyond a placement region's edge
 Z_TOL = 0.02  # how far above a surface an object may rest and still be "on" it
 SURFACE_TILT = np.pi / 4  # radians a placement surface may tilt and still hold what rests on it
 SHUT_TOL = 0.01  # metres a drawer may stand out and still count as shut
+HANG_GAP = 0.03  # metres a hanging object's lowest point stays above the table (a mug rack's base: 1.2 cm)
 CONTACT_TOL = 0.005  # metres within which an object's lowest point rests on a container's floor or rim
 
 
@@ -180,6 +181,15 @@ def moved(world: World, obj: str, start_xy: np.ndarray, distance: float) -> bool
     return bool(np.linalg.norm(world.object_pos(obj)[:2] - np.asarray(start_xy)[:2]) >= distance)
 
 
+def hanging(world: World, obj: str, host: str) -> bool:
+    """``obj`` hangs from ``host``: it touches ``host`` and its lowest point stays :data:`HANG_GAP`
+    above the table, so it rests neither on the table nor on ``host``'s base: ``host`` holds it up by
+    what stands above (a rack's peg). Not :func:`lifted` (its origin's height): a mug lying on its
+    side against a rack's base has its origin 6 cm up."""
+    low = world.object_lowest(obj, np.array([0.0, 0.0, 1.0]), np.array([0.0, 0.0, world.table_top()]))
+    return low >= HANG_GAP and contact_between(world, obj, host)
+
+
 def facing(world: World, obj: str, point: str | None = None, tol: float = 0.45) -> bool:
     """``obj``'s functional point (``point``; None: its face, see ``ObjectType.face``) faces the
     robot: its outward ``direction``, turned with the object, points at the robot's base within
@@ -213,3 +223,4 @@ ORACLE_CHECKS.add("pressed", lambda w, a: pressed(w, a))  # an event: the oracle
 ORACLE_CHECKS.add("opened", lambda w, a: opened(w, a))
 ORACLE_CHECKS.add("closed", lambda w, a: closed(w, a))
 ORACLE_CHECKS.add("facing", lambda w, a: facing(w, a))
+ORACLE_CHECKS.add("hanging", lambda w, a, b: hanging(w, a, b))

@@ -15,6 +15,7 @@ from vcage.assets.annotations import (
     HALF_PI,
     RIM_DROP,
     Annotations,
+    FunctionalPoint,
     Grasp,
     Placement,
     StableOrientation,
@@ -76,6 +77,7 @@ MUG_R, MUG_H, MUG_T, MUG_FLOOR = 0.04, 0.095, 0.004, 0.006
 MUG_HANDLE_X = 0.064  # centre of the handle's outer bar
 MUG_HANDLE_Z = 0.053
 MUG_HANDLE_W = 0.012  # extent of the handle along y
+MUG_HOLE_X = (MUG_R + MUG_HANDLE_X - 0.004) / 2  # the middle of the handle's opening
 
 
 def _mug(p: PartBuilder) -> None:
@@ -98,6 +100,9 @@ CATALOG.add_type(ObjectType(
         grasps=(Grasp("handle", (MUG_HANDLE_X, 0, MUG_HANDLE_Z), yaw=0.0, width=MUG_HANDLE_W),
                 *rim_grasps(MUG_R - MUG_T / 2, MUG_H - RIM_DROP, FOUR_SIDES[1:], MUG_T)),
         placements=(_round_inside(MUG_R, MUG_T, MUG_FLOOR, MUG_H),),
+        # the middle of the handle's opening, which a rack's peg goes through (skills.hanging)
+        functional_points=(FunctionalPoint("handle", "loop", (MUG_HOLE_X, 0, MUG_HANDLE_Z),
+                                           direction=(1.0, 0.0, 0.0)),),
     ),
 ))
 
