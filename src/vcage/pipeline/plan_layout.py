@@ -39,6 +39,11 @@ DRAWER_SKILLS = ("open_drawer", "close_drawer")  # plan skills that slide ``obj`
 # and stands far enough back in the work area that its drawer, pulled out, stays in it (clear of the
 # arm's home pose in the top view, where the critic measures how far it is out)
 DRAWER_YAW = 0.35
+HANG_SKILLS = ("hang",)  # plan skills that hang ``obj`` on ``target``'s hook
+# An object something is hung on turns its hook's free end towards the robot's right (-y), as
+# hanging_mug's rack stands, within this many radians: the hand then brings the held object from
+# the robot's side of the hook (a free end pointing away would need it to reach round the post)
+HOOK_YAW = 0.6
 
 
 def plan_layout(plan: Plan, rng: np.random.Generator, rand: Randomization, clutter: int = 0,
@@ -53,6 +58,7 @@ def plan_layout(plan: Plan, rng: np.random.Generator, rand: Randomization, clutt
     grasped = {str(st.args["obj"]) for st in plan.subtasks if st.skill in GRASPING_SKILLS}
     receives = _room_needed(plan, {name: look[0] for name, look in looks.items()})
     slides = _drawers_slid(plan, {name: look[0] for name, look in looks.items()})
+    hangs = _hooks_used(plan, {name: look[0] for name, look in looks.items()})
     objects = []
     for o in _largest_first(plan):
         scale, color, friction = looks[o.name]
@@ -63,10 +69,13 @@ def plan_layout(plan: Plan, rng: np.random.Generator, rand: Randomization, clutt
             region, yaw = _nominal(placed, rand)
         elif o.name in slides and not o.on:
             region, yaw = _drawer_pose(o.type, scale, slides[o.name], work_area)
+        elif o.name in hangs and not o.on:
+            yaw = _hook_yaw(o.type)
         room, room_at = receives.get(o.name, (0.0, None))
         objects.append(LayoutObject(o.name, o.type, support=support, region=region, yaw=yaw, scale=scale,
                                     color=color, friction=friction, grasped=o.name in grasped,
-                                    receives=room, receives_at=room_at, slides=slides.get(o.name, 0.0)))
+                                    receives=room, receives_at=room_at, slides=slides.get(o.name, 0.0),
+                                    hangs=hangs.get(o.name, 0.0)))
     relations = tuple(Relation(r.kind, r.a, r.b, r.distance) for r in plan.relations)
     reserved = tuple(
         ReservedZone(f"subtask{i}", Region((float(st.args["xy"][0]), float(st.args["xy"][1])),
@@ -122,6 +131,27 @@ def _drawers_slid(plan: Plan, scales: dict[str, float]) -> dict[str, float]:
         far = handle.stroke * scales[name] if st.args.get("distance") is None else float(st.args["distance"])
         out[name] = max(out.get(name, 0.0), far)
     return out
+
+
+def _hooks_used(plan: Plan, scales: dict[str, float]) -> dict[str, float]:
+    """For each object something is hung on: the room kept free at its hook's end (the largest
+    :func:`~vcage.scene.placement.geometry.carry_radius` of what is hung there)."""
+    types = {o.name: o.type for o in plan.objects}
+    out: dict[str, float] = {}
+    for st in plan.subtasks:
+        if st.skill in HANG_SKILLS and isinstance(st.args.get("target"), str):
+            held, host = str(st.args["obj"]), str(st.args["target"])
+            out[host] = max(out.get(host, 0.0), carry_radius(types[held], scales[held]))
+    return out
+
+
+def _hook_yaw(type_: str) -> tuple[float, float]:
+    """The yaw range of an object whose hook's free end turns towards the robot's right (-y)."""
+    hook = CATALOG.get(type_).point_of_kind("hook")
+    assert hook is not None  # the plan's check refuses a hang on an object without a hook
+    free_end = math.atan2(-hook.direction[1], -hook.direction[0])  # in the object's frame
+    facing = -math.pi / 2 - free_end
+    return facing - HOOK_YAW, facing + HOOK_YAW
 
 
 def _drawer_pose(type_: str, scale: float, out: float,

@@ -72,7 +72,9 @@ class LayoutObject:
     (None: the first) of an object the robot will put something on or in: what the hand carries
     there, fingers included. ``slides`` is how far the object's drawer will come out: the ground
     in front of it, as wide as the object, and the hand's room at the handle at that opening, are
-    kept free.
+    kept free. ``hangs`` is the radius kept free around the free end of the object's hook (its
+    functional point of kind ``hook``), where something will be hung: what hangs there and the hand
+    that brings it.
     """
 
     name: str
@@ -88,6 +90,7 @@ class LayoutObject:
     receives: float = 0.0
     receives_at: str | None = None
     slides: float = 0.0
+    hangs: float = 0.0
 
     def __post_init__(self) -> None:
         if self.yaw[0] > self.yaw[1]:

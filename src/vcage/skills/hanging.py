@@ -4,7 +4,8 @@ The object's ``loop`` is a functional point in the middle of the opening that go
 ``direction`` the way the opening faces (a mug's handle: outward from the body); the host's ``hook``
 is a functional point at the hook's free end, ``direction`` along the hook towards where it is
 fixed (:mod:`vcage.assets.annotations`). The hand takes the grasp farthest from the loop, lifts,
-turns the held object so that the opening's axis runs along the hook, carries the opening to just
+turns the held object so that the opening's axis runs along the hook (its loop facing away from the
+robot, the hand on the robot's side), carries the opening over the host and down to just
 beyond the hook's end, threads it on along the hook, lowers it onto the hook, lets go and moves up:
 one plan, open loop from the state it is planned in, like ``pick_and_place``.
 """
@@ -19,12 +20,14 @@ from vcage.assets.annotations import FunctionalPoint
 from vcage.assets.catalog import CATALOG
 from vcage.errors import SkillError
 from vcage.geometry import rot_z, wrap_angle, yaw_of
+from vcage.scene.spec import ROBOT_MOUNT
 from vcage.sim.world import World
 from vcage.skills.base import CLOSED, SKILLS, Skills
 from vcage.skills.motion import MotionPlan, Waypoint
 from vcage.skills.primitives import lift, move_line, move_to, open_gripper, rotate
 
 LIFT = 0.2  # metres above the table the held object is lifted to before it turns
+OVER = 0.03  # the held object's bottom passes this far above the host's top on its way to the hook
 BEFORE = 0.035  # the opening waits this far beyond the hook's end before threading
 ON_HOOK = 0.03  # and ends this far along the hook from its end
 DROP = 0.022  # the loop's upper bar is then lowered onto the hook
@@ -70,14 +73,22 @@ def hung(s: Skills, obj: str, target: str, point: str | None = None, thread: flo
     choice, wps = s.choose_grasp(obj, grasps[0].name)  # the grasp farthest from the loop
     wps.append(Waypoint(wps[-1].q, CLOSED, 0.3, hold=0.5, label="close"))
     plan = MotionPlan("hang", tuple(wps))
-    # the opening faces across the hook: its axis (perpendicular to the way it faces) along the hook
+    # the opening faces across the hook (the hook runs through it), away from the robot of the two
+    # ways: the object's body, and the hand holding it, stay on the robot's side of the hook
     facing = yaw_of(rot) + math.atan2(loop.direction[1], loop.direction[0])
-    turn = wrap_angle(math.atan2(axis[1], axis[0]) - math.pi / 2 - facing)
+    away = math.atan2(end[1] - ROBOT_MOUNT[1], end[0] - ROBOT_MOUNT[0])
+    along = math.atan2(axis[1], axis[0])
+    wanted = min((along - math.pi / 2, along + math.pi / 2), key=lambda a: abs(wrap_angle(a - away)))
+    turn = wrap_angle(wanted - facing)
     offset = rot_z(turn) @ (hole - choice.pos)  # the loop relative to the TCP, once turned
     wait = end - axis * BEFORE - offset
     on = wait + axis * (BEFORE + ON_HOOK) * thread
-    steps = (lambda: lift(s, height=LIFT), lambda: rotate(s, turn), lambda: move_to(s, wait),
-             lambda: move_line(s, on, speed=THREAD_SPEED),
+    # the object comes down onto the waiting point from above the host, which it would hit on the way
+    host = world.object(target)
+    top = world.object_pos(target)[2] + CATALOG.get(host.type_name).size[2] * host.scale
+    over = wait + [0.0, 0.0, max(0.0, top + OVER + loop.pos[2] * inst.scale - end[2])]
+    steps = (lambda: lift(s, height=LIFT), lambda: rotate(s, turn), lambda: move_to(s, over),
+             lambda: move_line(s, wait), lambda: move_line(s, on, speed=THREAD_SPEED),
              lambda: move_line(s, on - [0.0, 0.0, DROP], speed=THREAD_SPEED), lambda: open_gripper(s),
              lambda: move_line(s, on + [0.0, 0.0, CLEAR - DROP]))
     for step in steps:  # each planned from where the one before ends

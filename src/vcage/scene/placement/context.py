@@ -199,8 +199,9 @@ class ContextAwarePlacer(Placer):
 
     def _zone(self, obj: LayoutObject, yaw: float, xy: tuple[float, float]) -> tuple[Polygon, ...]:
         """The ground the hand needs around a task object on the table: its finger zones if the
-        robot grasps it, the room of what it carries there if it receives something, and where its
-        drawer comes out if the robot opens it."""
+        robot grasps it, the room of what it carries there if it receives something, where its
+        drawer comes out if the robot opens it, and the room at its hook's end if something is hung
+        on it."""
         if not (self.config.finger_zones and obj.task and obj.support.is_table):
             return ()
         slack = self.config.finger_slack
@@ -211,6 +212,10 @@ class ContextAwarePlacer(Placer):
             pieces += (Point(center).buffer(obj.receives + slack, 16),)
         if obj.slides > 0:
             pieces += (drawer_zone(obj.type, obj.scale, yaw, obj.slides, xy, slack),)
+        hook = CATALOG.get(obj.type).point_of_kind("hook")
+        if obj.hangs > 0 and hook is not None:
+            end = to_world(xy, yaw, (hook.pos[0] * obj.scale, hook.pos[1] * obj.scale))
+            pieces += (Point(end).buffer(obj.hangs + slack, 16),)
         return pieces
 
     def _commit(self, obj: LayoutObject, pose: Pose) -> None:
