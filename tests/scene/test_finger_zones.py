@@ -217,3 +217,31 @@ def test_a_drawer_the_plan_slides_faces_the_robot_and_nothing_stands_where_it_co
     x0, y0, x1, y1 = z.bounds
     assert x1 == pytest.approx(0.7 - 0.1025) and x0 == pytest.approx(0.7 - 0.1025 - 0.12 - R.FINGER_OUTER)
     assert (y0, y1) == (pytest.approx(-0.11), pytest.approx(0.11))
+
+
+def test_a_rack_the_plan_hangs_a_mug_on_turns_its_peg_to_the_robots_right_with_room_at_its_end(reach):
+    """The peg's free end points to the robot's right (as hanging_mug's rack stands), and nothing
+    stands within the hung mug's reach of it; with finger zones off, something does."""
+    from vcage.pipeline.plan_layout import plan_layout
+    from vcage.planning import make_planner
+    from vcage.planning.config import PlannerConfig
+    from vcage.scene.placement.geometry import carry_radius
+
+    plan = make_planner(PlannerConfig()).plan("tidy the coffee corner")
+    layout = plan_layout(plan, np.random.default_rng(0), Randomization(), clutter=8)
+    rack = next(o for o in layout.objects if o.type == "mug_rack")
+    mug = next(o for o in layout.objects if o.type == "mug")
+    assert rack.hangs == pytest.approx(carry_radius("mug", mug.scale))
+    assert all(o.hangs == 0 for o in layout.objects if o is not rack)
+    assert -0.7 < rack.yaw[0] < rack.yaw[1] < 0.7  # its free end (rack frame -y) towards world -y
+    counts = {True: 0, False: 0}
+    for zones in (True, False):
+        for seed in range(8):
+            placed = place(layout, np.random.default_rng(seed), config=PlacementConfig(finger_zones=zones),
+                           reach=reach).scene
+            r = next(o for o in placed.objects if o.name == rack.name)
+            end = (r.xy[0] + 0.06 * math.sin(r.yaw), r.xy[1] - 0.06 * math.cos(r.yaw))  # rack (0, -0.06)
+            room = shapely.Point(end).buffer(rack.hangs)
+            counts[zones] += sum(footprint(o.type, o.scale, o.yaw, o.xy).intersects(room)
+                                 for o in placed.objects if o.name != r.name)
+    assert counts[True] == 0 < counts[False]
