@@ -387,18 +387,6 @@ def test_a_mug_hung_on_one_rack_does_not_hang_from_the_other() -> None:
     assert "does not touch other" in verdict.reason
 
 
-def test_a_mug_set_down_on_a_tower_beside_the_rack_does_not_hang_from_it() -> None:
-    """As high above the table as hanging makes it and touching the rack from the top, but held up
-    by the three blocks under it (a Vanilla rollout set a mug down on a jar beside the rack so)."""
-    tower = tuple(O(f"b{i}", "block", (0.52, 0.04), z=0.75 + 0.045 * i) for i in range(3))
-    result = run((*MUG_RACK, *tower), _sub("pick_and_place", {"obj": "mug", "target": "b2"},
-                                            ("hanging", ("mug", "rack")), ("released", ("mug",))))
-    assert result.outcome.oracle == {"hanging(mug, rack)": False, "released(mug)": True}
-    verdict = CRITIC.judge(result.obs)
-    assert verdict.details["checks"]["hanging(mug, rack)"] is False, verdict.reason
-    assert "mug lies over b2" in verdict.reason and "rather than hanging from rack" in verdict.reason
-
-
 def test_the_checks_under_test_cover_every_image_check() -> None:
     from vcage.critics.image import IMAGE_CHECKS
 
