@@ -188,6 +188,20 @@ def test_what_rests_in_a_target_keeps_clear_of_the_room_it_receives_in(reach):
         place(crowded, np.random.default_rng(0), config=PlacementConfig(), reach=reach)
 
 
+def _intrusions(layout, reach, host: str, seeds: int, zone_of) -> dict[bool, int]:
+    """Footprints entering ``zone_of(host as placed)`` over ``seeds`` placements of ``layout``, with
+    finger zones on (True) and off (False)."""
+    counts = {True: 0, False: 0}
+    for zones in (True, False):
+        for seed in range(seeds):
+            placed = place(layout, np.random.default_rng(seed), config=PlacementConfig(finger_zones=zones),
+                           reach=reach).scene
+            zone = zone_of(next(o for o in placed.objects if o.name == host))
+            counts[zones] += sum(footprint(o.type, o.scale, o.yaw, o.xy).intersects(zone)
+                                 for o in placed.objects if o.name != host)
+    return counts
+
+
 def test_a_drawer_the_plan_slides_faces_the_robot_and_nothing_stands_where_it_comes_out(reach):
     from vcage.pipeline.plan_layout import WORK_AREA, plan_layout
     from vcage.planning import make_planner
@@ -200,17 +214,13 @@ def test_a_drawer_the_plan_slides_faces_the_robot_and_nothing_stands_where_it_co
     assert cabinet.slides == pytest.approx(0.12)
     assert all(o.slides == 0 for o in layout.objects if o is not cabinet)
     assert -0.5 < cabinet.yaw[0] < cabinet.yaw[1] < 0.5  # its handle (on its -x side) towards the robot
-    counts = {True: 0, False: 0}
-    for zones in (True, False):
-        for seed in range(6):
-            placed = place(layout, np.random.default_rng(seed), config=PlacementConfig(finger_zones=zones),
-                           reach=reach).scene
-            cab = next(o for o in placed.objects if o.name == cabinet.name)
-            zone = drawer_zone("cabinet", cab.scale, cab.yaw, 0.12, cab.xy)
-            front = cab.xy[0] - (0.1025 + 0.12) * math.cos(cab.yaw)  # the drawer's front, out 12 cm
-            assert zone.area > 0.0 and front >= WORK_AREA.bounds[0] - 1e-9, seed
-            counts[zones] += sum(footprint(o.type, o.scale, o.yaw, o.xy).intersects(zone)
-                                 for o in placed.objects if o.name != cab.name)
+    def sweep(cab):
+        zone = drawer_zone("cabinet", cab.scale, cab.yaw, 0.12, cab.xy)
+        front = cab.xy[0] - (0.1025 + 0.12) * math.cos(cab.yaw)  # the drawer's front, out 12 cm
+        assert zone.area > 0.0 and front >= WORK_AREA.bounds[0] - 1e-9
+        return zone
+
+    counts = _intrusions(layout, reach, cabinet.name, 6, sweep)
     assert counts[True] == 0 < counts[False]
     # the zone is the drawer's sweep: as wide as the cabinet, from its front towards -x at yaw 0
     z = drawer_zone("cabinet", 1.0, 0.0, 0.12, (0.7, 0.0))
@@ -234,14 +244,9 @@ def test_a_rack_the_plan_hangs_a_mug_on_turns_its_peg_to_the_robots_right_with_r
     assert rack.hangs == pytest.approx(carry_radius("mug", mug.scale))
     assert all(o.hangs == 0 for o in layout.objects if o is not rack)
     assert -0.7 < rack.yaw[0] < rack.yaw[1] < 0.7  # its free end (rack frame -y) towards world -y
-    counts = {True: 0, False: 0}
-    for zones in (True, False):
-        for seed in range(8):
-            placed = place(layout, np.random.default_rng(seed), config=PlacementConfig(finger_zones=zones),
-                           reach=reach).scene
-            r = next(o for o in placed.objects if o.name == rack.name)
-            end = (r.xy[0] + 0.06 * math.sin(r.yaw), r.xy[1] - 0.06 * math.cos(r.yaw))  # rack (0, -0.06)
-            room = shapely.Point(end).buffer(rack.hangs)
-            counts[zones] += sum(footprint(o.type, o.scale, o.yaw, o.xy).intersects(room)
-                                 for o in placed.objects if o.name != r.name)
+    def room(r):
+        end = (r.xy[0] + 0.06 * math.sin(r.yaw), r.xy[1] - 0.06 * math.cos(r.yaw))  # rack (0, -0.06)
+        return shapely.Point(end).buffer(rack.hangs)
+
+    counts = _intrusions(layout, reach, rack.name, 8, room)
     assert counts[True] == 0 < counts[False]
