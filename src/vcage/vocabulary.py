@@ -127,8 +127,7 @@ _skill("open_gripper", "Open the hand fully where it is.")
 _skill("open_drawer", "Pull ``obj``'s drawer out by its handle to ``distance`` metres (default: the "
        "handle's stroke).", _obj("obj"), _opt("point"), _opt("distance"))
 _skill("close_drawer", "Push ``obj``'s drawer shut by its handle.", _obj("obj"), _opt("point"))
-_skill("hang", "Hang ``obj`` by its loop (a mug's handle) on ``target``'s hook (a rack's peg): grasp, lift, "
-       "turn, thread the loop onto the hook, let go.", _obj("obj"), _obj("target"), _opt("point"))
-_skill("turn_to_face", "Grasp ``obj``, lift it and put it down turned so that its functional face points at "
-       "the robot: on ``target``, on the table at ``xy``, or where it stood.", _obj("obj"),
-       _obj("target", False), _opt("placement"), _opt("xy"), _opt("point"), _opt("grasp_name"))
+_skill("hang", "Hang ``obj`` by its loop (a mug's handle) on ``target``'s hook (a rack's peg).",
+       _obj("obj"), _obj("target"), _opt("point"))
+_skill("turn_to_face", "Grasp, lift and put down ``obj`` turned so that its face points at the robot.",
+       _obj("obj"), _obj("target", False), _opt("placement"), _opt("xy"), _opt("point"), _opt("grasp_name"))

@@ -57,7 +57,9 @@ def hook_end(world: World, host: str, point: str | None = None) -> tuple[np.ndar
 
 @SKILLS.register("hang")
 def hang(s: Skills, obj: str, target: str, point: str | None = None) -> MotionPlan:
-    """Hang ``obj`` by its loop on ``target``'s hook (``point``: the hook of that name)."""
+    """Hang ``obj`` by its loop (a mug's handle) on ``target``'s hook (a rack's peg).
+
+    ``point``: the hook of that name (default: the first)."""
     return hung(s, obj, target, point)
 
 

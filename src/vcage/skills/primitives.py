@@ -271,8 +271,10 @@ def turn_to_face_robot(world: World, obj: str, at: tuple[float, float] | None = 
 def turn_to_face(s: Skills, obj: str, target: str | None = None, placement: str | None = None,
                  xy: tuple[float, float] | None = None, point: str | None = None,
                  grasp_name: str | None = None) -> MotionPlan:
-    """Grasp ``obj``, lift it and put it down turned so that its functional point (``point``: its
-    first) faces the robot: on ``target``'s placement, on the table at ``xy``, or where it stood."""
+    """Grasp, lift and put down ``obj`` turned so that its face points at the robot.
+
+    It goes on ``target``'s placement, on the table at ``xy``, or back where it stood; ``point``
+    names the functional point to turn (default: the type's face, see ``ObjectType.face``)."""
     return turned_to_face(s, obj, target, placement, xy, point, grasp_name)
 
 
