@@ -96,3 +96,32 @@ def test_lifted_needs_the_object_to_rise_in_the_front_view() -> None:
     assert verdict.accept and oracle["lifted(block)"], verdict.reason
     verdict, oracle = _judge(resting, resting, _subtask(("lifted", ("block",))))
     assert not verdict.accept and not oracle["lifted(block)"] and "rose by 0 px" in verdict.reason
+
+
+def test_an_object_that_already_stood_tipped_is_not_upright() -> None:
+    """A bell lying on its side before and after the subtask: its outline and height did not change,
+    so only its height against its type's tells (a standing bell is at most 6.3 cm tall). A bell
+    standing is accepted, and so is one standing on a block (what stands under it raises it)."""
+    def judge(before: World, after: World) -> tuple[bool, str, bool]:
+        sub = _subtask(("upright", ("bell",)))
+        types = {n: after.object(n).type_name for n in after.object_names}
+        obs = Observation(subtask=sub, labels=tuple(after.object_names), before=_views(before),
+                          after=_views(after), types=types)
+        verdict = CRITIC.judge(obs)
+        return verdict.accept, verdict.reason, Oracle().check(after, sub.predicates)["upright(bell)"]
+
+    lying = compose(SceneSpec(objects=(ObjectSpec("bell", "bell", (0.55, 0.05), z=0.8),))).make_world()
+    adr = int(lying.model.jnt_qposadr[lying.model.joint("bell/free").id])
+    lying.data.qpos[adr + 3:adr + 7] = [np.cos(np.pi / 4), np.sin(np.pi / 4), 0.0, 0.0]  # on its side
+    lying.forward()
+    lying.settle(0.8)
+    accept, reason, upright = judge(lying, lying)
+    assert not upright and not accept and "higher than bell standing reaches" in reason, reason
+    standing = _world(ObjectSpec("bell", "bell", (0.55, 0.05)))
+    accept, reason, upright = judge(standing, standing)
+    assert upright and accept, reason
+    block = ObjectSpec("block", "block", (0.55, 0.05))
+    before = _world(block, ObjectSpec("bell", "bell", (0.45, -0.15)))
+    on_block = _world(block, ObjectSpec("bell", "bell", (0.55, 0.05), z=0.8))
+    accept, reason, upright = judge(before, on_block)
+    assert upright and accept, reason

@@ -39,7 +39,9 @@ simulator state. Each predicate is checked in image space:
   cannot show the contact; then the top view's cover and depth, both required, decide.
 - ``upright(x)``: ``x``'s top-view area (orthographic, so true to size wherever it stands) and the
   spread of its outline are close to what they were before, allowing for what the robot can hide;
-  its highest point (the top view's depth; without it, its front-view height) did not drop.
+  its highest point (the top view's depth; without it, its front-view height) did not drop, and
+  stands no higher than its type's height at the largest scale allows unless something stands
+  under it (a bell that lay tipped before the subtask too).
 - ``hanging(a, b)``: from the top view, ``a``'s highest point stands higher than ``a`` reaches
   resting any way up (its longest side, at its type's largest scale) and ``a`` touches ``b``.
 - ``facing(x)``: the short axis of ``x``'s tall part from the top (a board's plate, a fan's head)
@@ -95,6 +97,7 @@ STILL = 0.9  # share of an object's pixels within its outline before for it to c
 ROW_TOL = 3  # pixels of slack for row comparisons in the front view
 AREA_RATIO = (0.8, 1.25)  # top-view (orthographic) area after / before of an object that stayed upright
 SHAPE_RATIO = 1.2  # top-view long-axis spread after / before (either way) of an object that stayed upright
+UPRIGHT_TOL = 0.005  # metres an upright object's top may stand beyond its type's height range
 HEIGHT_RATIO = 0.8  # highest point (front view without depth: height) after / before, stayed upright
 # How far (metres) the top of an object that ``a`` lies over may stand above ``b``'s surface (the
 # oracle's tolerance for "on"), and how far above what resting on ``b`` allows ``a``'s lowest top-view
@@ -757,6 +760,9 @@ def _upright(obs: Observation, x: str) -> tuple[bool, str]:
         was, now = (float(np.percentile(h[_inner(m)], 95)) for h, m in ((hb, mb), (ha, ma)))
         if now < HEIGHT_RATIO * was:
             return False, f"{x}'s top stands x{now / max(was, 1e-9):.2f} as high as before (tipped over?)"
+        off = _off_height(obs, after, x, now)
+        if off is not None:
+            return False, off
         return True, "upright"
     # without the top view's depth, its height in the front view (which a thin object turned about
     # the vertical changes too: a board's plate seen edge-on, its top edge runs away from the camera)
@@ -764,6 +770,22 @@ def _upright(obs: Observation, x: str) -> tuple[bool, str]:
     if rb and ra and (ra[1] - ra[0] + 1) < HEIGHT_RATIO * (rb[1] - rb[0] + 1):
         return False, f"{x} looks lower in the front view than before (tipped over?)"
     return True, "upright"
+
+
+def _off_height(obs: Observation, top: View, x: str, high: float) -> str | None:
+    """Why ``x``, whose highest point stands ``high`` above the table, cannot stand upright on the
+    table (None if it can, or its type cannot tell): standing on its base its top is at most its
+    type's height at the largest scale (plus :data:`UPRIGHT_TOL`); higher, it stands tipped on a side
+    wider than its base is tall, unless it rests on another object. (Lower says little: a small
+    button on a dome is too few pixels for the top view's highest reading.) Containers are left
+    out: from the top a hollow one shows its inside."""
+    otype = _type_of(obs, x)
+    if otype is None or any(p.kind == "in" for p in otype.placements):
+        return None
+    if high > otype.size[2] * otype.scale_range[1] + UPRIGHT_TOL \
+            and _not_down(obs, top, x, None, 0.0, "the table", (x,)) is None:
+        return f"{x}'s top is {100 * high:.1f} cm above the table, higher than {x} standing reaches (tipped?)"
+    return None
 
 
 def _on_table(obs: Observation, a: str) -> tuple[bool, str]:
