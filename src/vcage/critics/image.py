@@ -327,13 +327,13 @@ def _on_rim(obs: Observation, top: View, a: str, b: str,
     if ring.sum() < UNDER_PX or float(np.median(hb[ring])) > HEIGHT_TOL:
         return None  # not seen standing on the table before: its own height is not known
     rim = float(np.percentile(hb[mb], RIM_PERCENTILE))
-    own = float(np.percentile(hb[_inner(was)], 95))
+    own = _highest(hb, was)
     if lean is not None:
         heights, plane, slope = lean
         low_end = float(np.percentile(heights[plane <= np.percentile(plane, 25)], 95))
         under = rim - (low_end - own * float(np.hypot(1.0, slope)))
     else:
-        under = rim - (float(np.percentile(ha[_inner(now)], 95)) - own)
+        under = rim - (_highest(ha, now) - own)
     if under < RIM_GAP:
         where = f"{100 * under:.1f} cm under" if under >= 0 else f"{-100 * under:.1f} cm above"
         return f"{a}'s underside is {where} {b}'s rim: it rests on the rim or on something, not down in {b}"
@@ -360,7 +360,7 @@ def _not_down(obs: Observation, top: View, a: str, surface: float | None, floor:
         above = float(ha[ma].min()) - height - surface
         if above > HEIGHT_TOL:
             return f"{a} stands {100 * above:.1f} cm higher than resting on {where} allows"
-        taller = float(np.percentile(ha[_inner(ma)], 95)) - height - surface
+        taller = _highest(ha, ma) - height - surface
         if standing and taller > TOP_TOL:
             too_tall = f"{a}'s top is {100 * taller:.1f} cm higher than {a} standing on {where} reaches"
     surface = floor if surface is None else surface
@@ -587,6 +587,12 @@ def _heights(view: View) -> np.ndarray | None:
     return float(np.median(view.depth[view.segmentation == -1])) - view.depth
 
 
+def _highest(heights: np.ndarray, mask: np.ndarray) -> float:
+    """The highest point of ``mask`` in a top view's ``heights``, read inside its outline (see
+    :func:`_inner`) at the 95th percentile, so that a few stray pixels do not set it."""
+    return float(np.percentile(heights[_inner(mask)], 95))
+
+
 def _inner(mask: np.ndarray) -> np.ndarray:
     """``mask`` without its outline (all of it, if nothing is left): a pixel's depth at a silhouette
     can be far off (one at 0.25 m above the table on a 9 cm clock was seen), so an object's highest
@@ -670,7 +676,7 @@ def _drawer(obs: Observation, x: str) -> tuple[float, float, bool] | str:
 def _scale(otype: ObjectType, heights: np.ndarray, mask: np.ndarray) -> float:
     """An object's scale from its top (the 95th percentile of its inner heights: a stray pixel's depth
     can be far off) over its type's height, within the type's scale range."""
-    top = float(np.percentile(heights[_inner(mask)], 95))
+    top = _highest(heights, mask)
     return float(np.clip(top / otype.size[2], *otype.scale_range))
 
 
@@ -693,7 +699,7 @@ def _in_drawer(obs: Observation, a: str, b: str, place: Placement) -> tuple[bool
     drawer = _drawer(obs, b)
     if isinstance(drawer, str) or drawer[0] < drawer[1]:
         return False, f"{b}'s drawer is not open after the subtask, so {a} cannot be seen in it"
-    top = float(np.percentile(hb[_inner(mb)], 95))
+    top = _highest(hb, mb)
     body = mb & (hb >= top - TOP_BAND_BODY)
     share = float((ma & dilate(mb & ~body, 1)).sum() / ma.sum())
     if share < IN_DRAWER:
@@ -706,7 +712,7 @@ def _in_drawer(obs: Observation, a: str, b: str, place: Placement) -> tuple[bool
         return False, f"{a} lies {100 * (low - rim):.1f} cm higher than the rim of {b}'s drawer"
     atype = _type_of(obs, a)
     if atype is not None:
-        a_top = float(np.percentile(ha[_inner(ma)], 95))
+        a_top = _highest(ha, ma)
         least = floor + atype.size[2] * atype.scale_range[0] - FLOOR_TOL
         if a_top < least:
             return False, (f"{a}'s top is {100 * (least - a_top):.1f} cm lower than lying on the floor of "
@@ -757,7 +763,7 @@ def _upright(obs: Observation, x: str) -> tuple[bool, str]:
                 return False, f"{x}'s top-view outline stretched by x{axes:.2f} (tipped over?)"
     hb, ha = _heights(before), _heights(after)
     if hb is not None and ha is not None and mb.any() and ma.any():  # its highest point, from the top
-        was, now = (float(np.percentile(h[_inner(m)], 95)) for h, m in ((hb, mb), (ha, ma)))
+        was, now = (_highest(h, m) for h, m in ((hb, mb), (ha, ma)))
         if now < HEIGHT_RATIO * was:
             return False, f"{x}'s top stands x{now / max(was, 1e-9):.2f} as high as before (tipped over?)"
         off = _off_height(obs, after, x, now)
@@ -870,7 +876,7 @@ def _facing(obs: Observation, a: str) -> tuple[bool, str]:
     heights, mask = _heights(top), _mask(obs, top, a)
     if heights is None or not mask.any():
         return False, f"{a} is not visible from the top (or the top view has no depth)"
-    tall = mask & (heights > 0.5 * float(np.percentile(heights[_inner(mask)], 95)))
+    tall = mask & (heights > 0.5 * _highest(heights, mask))
     rows, cols = np.nonzero(tall)
     if len(rows) < 3:
         return False, f"{a}'s upper part does not show from the top"
@@ -910,7 +916,7 @@ def _hanging(obs: Observation, a: str, b: str) -> tuple[bool, str]:
     ma, mb = _mask(obs, top, a), _mask(obs, top, b)
     if not ma.any() or not mb.any():
         return False, f"{a} or {b} is not visible from the top"
-    high = float(np.percentile(heights[_inner(ma)], 95))
+    high = _highest(heights, ma)
     if high < reach + HANG_CLEAR:
         return False, (f"{a}'s top is {100 * high:.1f} cm above the table, no higher than it reaches "
                        f"resting any way up ({100 * reach:.1f} cm): it does not hang")
