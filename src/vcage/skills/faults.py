@@ -48,6 +48,7 @@ from vcage.skills.primitives import (
     press,
     push,
     shake,
+    taken,
     turn_and_place,
     turned_to_face,
 )
@@ -163,9 +164,7 @@ def _surface(s: Skills, args: Args) -> np.ndarray:
 
 def _pick(s: Skills, obj: str, grasp_name: str | None) -> tuple[MotionPlan, np.ndarray]:
     """Grasp and lift ``obj``; the plan and the object's origin relative to the TCP."""
-    choice, wps = s.choose_grasp(obj, grasp_name)
-    wps.append(Waypoint(wps[-1].q, CLOSED, 0.3, hold=0.5, label="close"))
-    plan = MotionPlan("pick_and_place", tuple(wps))
+    choice, plan = taken(s, obj, "pick_and_place", grasp_name)
     offset = s.world.object_pos(obj) - choice.pos
     with s.after(plan):
         plan = plan + lift(s)

@@ -22,9 +22,9 @@ from vcage.errors import SkillError
 from vcage.geometry import rot_z, wrap_angle, yaw_of
 from vcage.scene.spec import ROBOT_MOUNT
 from vcage.sim.world import World
-from vcage.skills.base import CLOSED, SKILLS, Skills
-from vcage.skills.motion import MotionPlan, Waypoint
-from vcage.skills.primitives import lift, move_line, move_to, open_gripper, rotate
+from vcage.skills.base import SKILLS, Skills
+from vcage.skills.motion import MotionPlan
+from vcage.skills.primitives import lift, move_line, move_to, open_gripper, rotate, taken
 
 LIFT = 0.2  # metres above the table the held object is lifted to before it turns
 OVER = 0.03  # the held object's bottom passes this far above the host's top on its way to the hook
@@ -72,9 +72,7 @@ def hung(s: Skills, obj: str, target: str, point: str | None = None, thread: flo
     hole = pos + rot @ (np.asarray(loop.pos) * inst.scale)
     grasps = sorted(CATALOG.get(inst.type_name).grasps,
                     key=lambda g: -float(np.linalg.norm(np.subtract(g.pos, loop.pos)[:2])))
-    choice, wps = s.choose_grasp(obj, grasps[0].name)  # the grasp farthest from the loop
-    wps.append(Waypoint(wps[-1].q, CLOSED, 0.3, hold=0.5, label="close"))
-    plan = MotionPlan("hang", tuple(wps))
+    choice, plan = taken(s, obj, "hang", grasps[0].name)  # the grasp farthest from the loop
     # the opening faces across the hook (the hook runs through it), away from the robot of the two
     # ways: the object's body, and the hand holding it, stay on the robot's side of the hook
     facing = yaw_of(rot) + math.atan2(loop.direction[1], loop.direction[0])

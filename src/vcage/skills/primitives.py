@@ -25,6 +25,7 @@ from vcage.skills.base import (
     SKILLS,
     SLOW_SPEED,
     TCP_MIN_ABOVE_TABLE,
+    GraspChoice,
     Skills,
 )
 from vcage.skills.ik import down_rotation
@@ -60,9 +61,16 @@ def close_gripper(s: Skills) -> MotionPlan:
 @SKILLS.register("grasp")
 def grasp(s: Skills, obj: str, grasp_name: str | None = None) -> MotionPlan:
     """Approach ``obj`` from above along its best reachable grasp annotation and close the hand."""
-    _, wps = s.choose_grasp(obj, grasp_name)
+    return taken(s, obj, "grasp", grasp_name)[1]
+
+
+def taken(s: Skills, obj: str, skill: str, grasp_name: str | None = None,
+          then_turn: float = 0.0) -> tuple[GraspChoice, MotionPlan]:
+    """The grasp chosen on ``obj`` (see :meth:`~vcage.skills.base.Skills.choose_grasp`) and the plan,
+    named ``skill``, that approaches it and closes the hand: the start of every skill that picks."""
+    choice, wps = s.choose_grasp(obj, grasp_name, then_turn)
     wps.append(Waypoint(wps[-1].q, CLOSED, 0.3, hold=0.5, label="close"))
-    return MotionPlan("grasp", tuple(wps))
+    return choice, MotionPlan(skill, tuple(wps))
 
 
 @SKILLS.register("lift")
@@ -135,9 +143,7 @@ def _lower_and_release(s: Skills, surface: np.ndarray, offset: np.ndarray, hand_
 def pick_and_place(s: Skills, obj: str, target: str | None = None, placement: str | None = None,
                    xy: tuple[float, float] | None = None, grasp_name: str | None = None) -> MotionPlan:
     """Grasp, lift, place and withdraw, planned open loop from the current state."""
-    choice, wps = s.choose_grasp(obj, grasp_name)
-    wps.append(Waypoint(wps[-1].q, CLOSED, 0.3, hold=0.5, label="close"))
-    plan = MotionPlan("pick_and_place", tuple(wps))
+    choice, plan = taken(s, obj, "pick_and_place", grasp_name)
     offset = s.world.object_pos(obj) - choice.pos  # where the object will sit relative to the TCP
     with s.after(plan):
         plan = plan + lift(s)
@@ -293,9 +299,7 @@ def turned_to_face(s: Skills, obj: str, target: str | None = None, placement: st
         here = s.world.object_pos(obj)
         at = (float(here[0]), float(here[1])) if xy is None else (float(xy[0]), float(xy[1]))
     turn = share * turn_to_face_robot(s.world, obj, (at[0], at[1]), point)
-    choice, wps = s.choose_grasp(obj, grasp_name, then_turn=turn)  # the wrist turns about its heading now
-    wps.append(Waypoint(wps[-1].q, CLOSED, 0.3, hold=0.5, label="close"))
-    plan = MotionPlan("turn_to_face", tuple(wps))
+    choice, plan = taken(s, obj, "turn_to_face", grasp_name, then_turn=turn)  # the wrist turns about now
     offset = s.world.object_pos(obj) - choice.pos  # where the object will sit relative to the TCP
     with s.after(plan):
         plan = plan + lift(s, height=FACE_LIFT)
