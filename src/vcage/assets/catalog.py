@@ -140,5 +140,13 @@ class Catalog(Registry[ObjectType]):
     def by_tag(self, tag: str) -> list[ObjectType]:
         return [o for o in self.values() if tag in o.tags]
 
+    def names_where(self, test: Callable[[ObjectType], object]) -> list[str]:
+        """The names of the types that pass ``test`` (for messages that say which types would do)."""
+        return [o.name for o in self.values() if test(o)]
+
+    def with_point(self, kind: str) -> list[str]:
+        """The names of the types with a functional point of ``kind`` (a loop, a hook)."""
+        return [o.name for o in self.values() if o.point_of_kind(kind) is not None]
+
 
 CATALOG = Catalog()

@@ -289,7 +289,7 @@ class OfflinePlanner:
             if not places:
                 raise PlanningError(f"nothing can be put on or in the {t.type.replace('_', ' ')} "
                                     f"(in {bounded(clause)}); objects that hold others: "
-                                    f"{', '.join(x.name for x in CATALOG.values() if x.placements)}")
+                                    f"{', '.join(CATALOG.names_where(lambda t: t.placements))}")
             kind = places[0].kind
             text = f"the {_words(o)} is {'in' if kind == 'in' else 'on'} the {_words(t)}"
             return (put_in if kind == "in" else put_on)(o.name, t.name, text)
@@ -299,7 +299,7 @@ class OfflinePlanner:
             _check_colour(ref, ref.type)
             o = objects.resolve(ref, ref.type, clause)
             if not CATALOG.get(o.type).drawer_handles:
-                with_drawers = [x.name for x in CATALOG.values() if x.drawer_handles]
+                with_drawers = CATALOG.names_where(lambda t: t.drawer_handles)
                 raise PlanningError(f"a {o.type.replace('_', ' ')} has no drawer to open or close (in "
                                     f"{bounded(clause)}); objects with a drawer: {', '.join(with_drawers)}")
             if m["verb"] in ("close", "shut"):
@@ -313,7 +313,7 @@ class OfflinePlanner:
             o, t = objects.resolve(o_ref, o_ref.type, clause), objects.resolve(t_ref, t_ref.type, clause)
             for x, kind, what in ((o, "loop", "hung up"), (t, "hook", "hung from")):
                 if CATALOG.get(x.type).point_of_kind(kind) is None:
-                    having = [y.name for y in CATALOG.values() if y.point_of_kind(kind) is not None]
+                    having = CATALOG.with_point(kind)
                     raise PlanningError(f"a {x.type.replace('_', ' ')} has no {kind} to be {what} (in "
                                         f"{bounded(clause)}); objects with one: {', '.join(having)}")
             return hang(o.name, t.name, f"the {_words(o)} hangs on the {_words(t)}")
@@ -323,7 +323,7 @@ class OfflinePlanner:
             _check_colour(ref, ref.type)
             o = objects.resolve(ref, ref.type, clause)
             if CATALOG.get(o.type).face is None:
-                faced = [x.name for x in CATALOG.values() if x.face is not None]
+                faced = CATALOG.names_where(lambda t: t.face is not None)
                 raise PlanningError(f"a {o.type.replace('_', ' ')} has no face to turn towards the robot (in "
                                     f"{bounded(clause)}); objects with one: {', '.join(faced)}")
             return turn_to_face(o.name, f"the {_words(o)} is turned to face the robot, standing on the table")

@@ -163,7 +163,7 @@ class Plan(_Strict):
                     if not isinstance(name, str) or name not in types \
                             or CATALOG.get(types[name]).point_of_kind(kind) is not None:
                         continue
-                    having = [t.name for t in CATALOG.values() if t.point_of_kind(kind) is not None]
+                    having = CATALOG.with_point(kind)
                     raise ValueError(f"subtask {i} ({st.skill}) hangs {obj!r} on {host!r}, but {name!r}, "
                                      f"a {types[name]}, has no {kind}; objects with one: {having}")
 
@@ -176,7 +176,7 @@ class Plan(_Strict):
             named += [p.args[0] for p in st.predicates if p.name == "facing" and p.args]
             for obj in named:
                 if isinstance(obj, str) and obj in types and CATALOG.get(types[obj]).face is None:
-                    faced = [t.name for t in CATALOG.values() if t.face is not None]
+                    faced = CATALOG.names_where(lambda t: t.face is not None)
                     raise ValueError(f"subtask {i} ({st.skill}) turns {obj!r}, a {types[obj]}, to face the "
                                      f"robot, but it has no face to turn; objects with one: {faced}")
 

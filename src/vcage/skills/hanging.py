@@ -40,7 +40,7 @@ def point_of(world: World, obj: str, kind: str, point: str | None = None) -> Fun
     otype = CATALOG.get(world.object(obj).type_name)
     fp = otype.point_of_kind(kind, point)
     if fp is None:
-        having = [t.name for t in CATALOG.values() if t.point_of_kind(kind) is not None]
+        having = CATALOG.with_point(kind)
         raise SkillError(f"{obj!r} ({otype.name}) has no {kind}" + (f" named {point!r}" if point else "")
                          + f"; objects with one: {having}")
     return fp
