@@ -30,30 +30,30 @@ class OrthoCamera:
     @classmethod
     def from_world(cls, world: World, camera: str, width: int, height: int) -> OrthoCamera:
         model = world.model
-        cam = model.camera(camera)
-        if int(model.cam_projection[cam.id]) != int(mujoco.mjtProjection.mjPROJ_ORTHOGRAPHIC):
-            raise ConfigError(f"camera {camera!r} is not orthographic")
+        cam = _orthographic(model, camera)
         mujoco.mj_kinematics(model, world.data)
         mujoco.mj_camlight(model, world.data)
-        mat = world.data.cam_xmat[cam.id].reshape(3, 3)
-        axes = tuple(tuple(float(v) for v in mat[:, i]) for i in range(3))
-        return cls(tuple(float(v) for v in world.data.cam_xpos[cam.id]), axes,  # type: ignore[arg-type]
-                   float(model.cam_fovy[cam.id]), width, height)
+        return cls._posed(model, cam, world.data.cam_xpos[cam], world.data.cam_xmat[cam], width, height)
 
     @classmethod
     def fixed(cls, model: mujoco.MjModel, camera: str, width: int, height: int) -> OrthoCamera:
         """The camera of ``model`` fixed in the world (on its world body), read from the model alone:
         no simulator data is computed or touched."""
-        cam = model.camera(camera)
-        if int(model.cam_projection[cam.id]) != int(mujoco.mjtProjection.mjPROJ_ORTHOGRAPHIC):
-            raise ConfigError(f"camera {camera!r} is not orthographic")
-        if int(model.cam_bodyid[cam.id]) != 0:
+        cam = _orthographic(model, camera)
+        if int(model.cam_bodyid[cam]) != 0:
             raise ConfigError(f"camera {camera!r} moves with a body; its pose needs the simulator's data")
         mat = np.zeros(9)
-        mujoco.mju_quat2Mat(mat, model.cam_quat[cam.id])
-        axes = tuple(tuple(float(v) for v in mat.reshape(3, 3)[:, i]) for i in range(3))
-        return cls(tuple(float(v) for v in model.cam_pos[cam.id]), axes,  # type: ignore[arg-type]
-                   float(model.cam_fovy[cam.id]), width, height)
+        mujoco.mju_quat2Mat(mat, model.cam_quat[cam])
+        return cls._posed(model, cam, model.cam_pos[cam], mat, width, height)
+
+    @classmethod
+    def _posed(cls, model: mujoco.MjModel, cam: int, pos: np.ndarray, mat: np.ndarray, width: int,
+               height: int) -> OrthoCamera:
+        """Camera ``cam`` of ``model`` at world position ``pos`` with rotation ``mat`` (9, row-major)."""
+        rot = np.asarray(mat).reshape(3, 3)
+        axes = tuple(tuple(float(v) for v in rot[:, i]) for i in range(3))
+        return cls(tuple(float(v) for v in pos), axes,  # type: ignore[arg-type]
+                   float(model.cam_fovy[cam]), width, height)
 
     @property
     def pixel_size(self) -> float:
@@ -105,3 +105,11 @@ class OrthoCamera:
     def to_dict(self) -> dict[str, object]:
         return {"pos": self.pos, "axes": self.axes, "view_height": self.view_height, "width": self.width,
                 "height": self.height, "pixel_size": self.pixel_size}
+
+
+def _orthographic(model: mujoco.MjModel, camera: str) -> int:
+    """The id of ``model``'s camera ``camera``; ConfigError if it is not orthographic."""
+    cam = int(model.camera(camera).id)
+    if int(model.cam_projection[cam]) != int(mujoco.mjtProjection.mjPROJ_ORTHOGRAPHIC):
+        raise ConfigError(f"camera {camera!r} is not orthographic")
+    return cam

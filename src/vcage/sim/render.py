@@ -64,6 +64,7 @@ class Renderer:
             self.model = render_model(model, mesh_detail)
         self._renderer: mujoco.Renderer | None = mujoco.Renderer(self.model, height, width)
         self._cameras = {model.camera(i).name for i in range(model.ncam)}
+        self._robot_pixels: dict[str, tuple[float, float] | None] = {}
 
     def _check(self, camera: str) -> mujoco.Renderer:
         if self._renderer is None:
@@ -121,7 +122,12 @@ class Renderer:
     def robot_pixel(self, camera: str) -> tuple[float, float] | None:
         """(row, column) at which the robot's base stands in an orthographic camera's view fixed in
         the world (its hand-eye calibration: the point may lie outside the image); None for other
-        cameras."""
+        cameras. Both stand still, so it is worked out once per camera."""
+        if camera not in self._robot_pixels:
+            self._robot_pixels[camera] = self._calibrate(camera)
+        return self._robot_pixels[camera]
+
+    def _calibrate(self, camera: str) -> tuple[float, float] | None:
         if not self._orthographic(camera) or int(self.world.model.cam_bodyid[
                 self.world.model.camera(camera).id]) != 0:
             return None
