@@ -183,9 +183,9 @@ def train_all(jobs: list[tuple[Path, Path, Any]], workers: int, threads: int,
 
 
 def budget_steps(jobs: list[tuple[Path, Path, Any]], budget: float, work: Path, workers: int, threads: int,
-                 device: str) -> int:
+                 device: str, probe_steps: int = PROBE_STEPS) -> int:
     """The training steps per run that fit ``budget`` seconds when ``jobs`` are trained ``workers``
-    at a time: that many of them train PROBE_STEPS steps (warm-up included, so the estimate errs
+    at a time: that many of them train ``probe_steps`` steps (warm-up included, so the estimate errs
     short) into a scratch directory at the same time; the slowest sets the rate, and the runs take
     ceil(jobs / workers) turns. A multiple of 1,000, at least 1,000."""
     import shutil
@@ -194,11 +194,11 @@ def budget_steps(jobs: list[tuple[Path, Path, Any]], budget: float, work: Path, 
     turns = -(-len(jobs) // at_once)
     scratch = work / "probe"
     shutil.rmtree(scratch, ignore_errors=True)
-    probes = [(dataset, scratch / f"{i}", replace(config, steps=PROBE_STEPS, checkpoint_every=PROBE_STEPS))
+    probes = [(dataset, scratch / f"{i}", replace(config, steps=probe_steps, checkpoint_every=probe_steps))
               for i, (dataset, _, config) in enumerate(jobs[:at_once])]
     timings = train_all(probes, at_once, threads, device)
     shutil.rmtree(scratch, ignore_errors=True)
-    rate = min(PROBE_STEPS / seconds for seconds, _, _ in timings.values())
+    rate = min(probe_steps / seconds for seconds, _, _ in timings.values())
     steps = max(1000, int(rate * budget / turns) // 1000 * 1000)
     print(f"  probe: {at_once} runs at once, the slowest at {rate:.1f} steps/s; {len(jobs)} runs in {turns} "
           f"turns: {steps} steps each for a {budget:.0f} s budget", flush=True)
@@ -405,6 +405,8 @@ def main() -> None:
     parser.add_argument("--device", default="cpu", help="training device: cpu, or cuda on a GPU machine")
     parser.add_argument("--budget", type=float, default=None,
                         help="train stage: pick --steps to fit this many seconds (a probe times all runs)")
+    parser.add_argument("--probe-steps", type=int, default=PROBE_STEPS,
+                        help="train stage: steps of the --budget probe (many runs at once make each slow)")
     parser.add_argument("--export", type=Path, default=None,
                         help="train stage: also write each final checkpoint, for evaluation only, here")
     parser.add_argument("--import", dest="import_from", type=Path, default=None,
@@ -431,6 +433,9 @@ def main() -> None:
     if args.stage == "data":
         return
     report(results, noise, args.bootstrap)
+    curves = plot_curves(args.work, tasks, args.train_seeds, args.work / "learning_curves.png")
+    if curves is not None:
+        print(f"\nlearning curves: {curves}")
     found = (re.search(r"step-(\d+)", str(r["checkpoint"])) for r in results)
     steps = sorted({int(m.group(1)) for m in found if m})
     print(f"\n{len(tasks)} tasks, {args.demos} demos per method, {args.train_seeds} training seeds, "
@@ -446,7 +451,70 @@ def data_stage(task: str, args: argparse.Namespace) -> tuple[dict[str, Path], li
     noise = audit(datasets["vanilla"]).label_noise
     scenes = solvable_scenes(task, datasets["vcage"], args.work, args.eval, base=1000 + args.seed)
     print(f"  {len(scenes)} held-out scenes; Vanilla label noise {noise:.1%}", flush=True)
+    kinds = failure_kinds(datasets["vanilla"])
+    if kinds:
+        print("  what the oracle finds wrong in Vanilla's demos (a demo may fail several): "
+              + ", ".join(f"{what} in {n}" for what, n in kinds.items()), flush=True)
     return datasets, scenes, noise
+
+
+def failure_kinds(dataset: Path) -> dict[str, int]:
+    """How many of the dataset's kept episodes fail each oracle predicate (or end in a skill error),
+    most frequent first: what the label noise consists of."""
+    from collections import Counter
+
+    from vcage.data.layout import ATTEMPTS_LOG
+    from vcage.pipeline.attempt_log import read
+    from vcage.pipeline.stage import Stage
+
+    counts: Counter[str] = Counter()
+    for rec in read(dataset / ATTEMPTS_LOG, torn_tail=False):
+        if rec["stage"] != Stage.ACCEPTED or rec["oracle_success"]:
+            continue
+        wrong = {what for row in rec["audit"] for what, holds in row["oracle"].items() if not holds}
+        wrong |= {f"skill error in {row['skill']}" for row in rec["audit"] if row.get("skill_error")}
+        counts.update(wrong)
+    return dict(counts.most_common())
+
+
+def plot_curves(work: Path, tasks: list[str], train_seeds: int, path: Path) -> Path | None:
+    """Each run's training loss (a moving mean over 1% of its steps), per task, V-CAGE against
+    Vanilla, into ``path`` (PNG); None when no run has a checkpoint."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from vcage.policy.checkpoint import latest_checkpoint, load_checkpoint
+
+    fig, axes = plt.subplots(1, len(tasks), figsize=(3.2 * len(tasks), 2.8), squeeze=False)
+    drawn = False
+    for ax, task in zip(axes[0], tasks, strict=True):
+        for method, colour in zip(METHODS, ("tab:blue", "tab:orange"), strict=True):
+            for seed in range(train_seeds):
+                latest = latest_checkpoint(run_dir(work, task, method, seed))
+                if latest is None:
+                    continue
+                loss = np.asarray(load_checkpoint(latest)["loss_history"], dtype=float)
+                width = max(1, len(loss) // 100)
+                smooth = np.convolve(loss, np.ones(width) / width, mode="valid")
+                ax.plot(np.arange(len(smooth)) + width, smooth, color=colour, lw=1,
+                        ls=("-", "--", ":")[seed % 3], label=f"{method} seed {seed}")
+                drawn = True
+        ax.set_yscale("log")
+        ax.set_title(task if len(task) <= 28 else task[:26] + "...", fontsize=8)
+        ax.set_xlabel("training step", fontsize=8)
+        ax.tick_params(labelsize=7)
+    axes[0][0].set_ylabel("denoising loss", fontsize=8)
+    axes[0][0].legend(fontsize=6)
+    if not drawn:
+        plt.close(fig)
+        return None
+    fig.tight_layout()
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
 
 
 def train_stage(tasks: list[str], args: argparse.Namespace) -> None:
@@ -459,7 +527,8 @@ def train_stage(tasks: list[str], args: argparse.Namespace) -> None:
             raise SystemExit(f"no dataset at {path}: run --stage data first")
     if pending and args.budget is not None:  # the steps that fit the budget, the same for every run
         probes = [(datasets[t, m], run_dir(args.work, t, m, s), train_config(args, s)) for t, m, s in pending]
-        args.steps = budget_steps(probes, args.budget, args.work, args.workers, args.threads, args.device)
+        args.steps = budget_steps(probes, args.budget, args.work, args.workers, args.threads, args.device,
+                                  args.probe_steps)
     jobs = [(datasets[t, m], run_dir(args.work, t, m, s), train_config(args, s)) for t, m, s in pending]
     trained = train_all(jobs, args.workers, args.threads, args.device)
     for (t, m, s), (_, run, config) in zip(pending, jobs, strict=True):

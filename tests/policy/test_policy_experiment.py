@@ -5,12 +5,14 @@ nothing)."""
 
 from __future__ import annotations
 
+import importlib.util
 import json
 import os
 import shutil
 import subprocess
 import sys
 from pathlib import Path
+from types import ModuleType
 
 from conftest import blocked_modules
 
@@ -28,8 +30,9 @@ def run(work: Path, *extra: str, env: dict[str, str] | None = None, ok: bool = T
 def test_the_quick_experiment_runs_end_to_end_and_resumes(tmp_path: Path) -> None:
     first = run(tmp_path)
     for line in ("Avg SR", "Top-5 (tasks)", "Top-5 (ckpts)", "V-CAGE - Vanilla success gap",
-                 "paired bootstrap 95%"):
+                 "paired bootstrap 95%", f"learning curves: {tmp_path / 'learning_curves.png'}"):
         assert line in first, first
+    assert (tmp_path / "learning_curves.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     results = sorted(p.relative_to(tmp_path).as_posix() for p in (tmp_path / "results").rglob("*.json"))
     assert results == ["results/press_the_bell/vanilla/seed0.json", "results/press_the_bell/vcage/seed0.json"]
     for path in (tmp_path / "results").rglob("*.json"):  # each checkpoint also ran on one training scene
@@ -65,3 +68,34 @@ def test_the_stages_run_apart_and_training_needs_no_simulator(tmp_path: Path) ->
         record = json.loads((work / "runs" / "press_the_bell" / method / "seed0" / "train.json").read_text())
         assert record["steps"] == 1000 and result["train_samples_per_second"] == record["samples_per_second"]
         assert result["episodes"] == 1
+
+
+def _experiment() -> ModuleType:
+    spec = importlib.util.spec_from_file_location("policy_experiment", SCRIPT)
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_failure_kinds_count_what_the_oracle_finds_wrong_in_kept_demos(tmp_path: Path) -> None:
+    """Each kept episode that fails the oracle counts once per failed predicate (and per skill error);
+    kept successes and rejected attempts count for nothing."""
+    def record(stage: str, success: bool, rows: list[dict[str, object]]) -> str:
+        return json.dumps({"stage": stage, "oracle_success": success, "audit": rows})
+
+    on_false = {"skill": "pick_and_place", "oracle": {"on(mouse, pad)": False, "released(mouse)": True}}
+    both_false = {"skill": "press", "oracle": {"pressed(bell)": False, "upright(bell)": False},
+                  "skill_error": "IK failed"}
+    fine = {"skill": "press", "oracle": {"pressed(bell)": True, "upright(bell)": True}}
+    log = tmp_path / "meta" / "vcage_attempts.jsonl"
+    log.parent.mkdir()
+    log.write_text("\n".join([
+        record("accepted", False, [on_false, fine]),
+        record("accepted", False, [on_false, both_false]),
+        record("accepted", True, [fine]),
+        record("rejected", False, [on_false]),  # not in the dataset
+    ]) + "\n")
+    kinds = _experiment().failure_kinds(tmp_path)
+    assert kinds == {"on(mouse, pad)": 2, "pressed(bell)": 1, "upright(bell)": 1, "skill error in press": 1}
+    assert next(iter(kinds)) == "on(mouse, pad)"  # most frequent first
