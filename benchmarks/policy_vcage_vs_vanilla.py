@@ -141,18 +141,19 @@ def train_config(args: argparse.Namespace, train_seed: int) -> Any:
 
 
 def train_run(dataset: Path, run: Path, config: Any, threads: int,
-              device: str = "cpu") -> tuple[float, float, float]:
+              device: str = "cpu", graph: bool = False) -> tuple[float, float, float]:
     """One training run (resumed if interrupted): its seconds, samples per second and final loss,
     also written to ``run/train.json`` once the run has reached its steps."""
     from vcage.policy.train import train
 
-    summary = train(dataset, run, config, resume=True, device=device, threads=threads, keep=2)
+    summary = train(dataset, run, config, resume=True, device=device, threads=threads, keep=2, graph=graph)
     done = (summary.seconds, summary.samples_per_second, summary.final_loss)
     if summary.start_step < summary.steps:  # a run resumed at its end measured nothing: keep the first record
         (run / TRAINED).write_text(json.dumps({
             "seconds": summary.seconds, "samples_per_second": summary.samples_per_second,
             "final_loss": summary.final_loss, "steps": summary.steps, "resumed_from": summary.start_step,
-            "parameters": summary.parameters, "device": device, "batch_size": config.batch_size}, indent=1))
+            "parameters": summary.parameters, "device": device, "cuda_graph": graph,
+            "batch_size": config.batch_size}, indent=1))
     return done
 
 
@@ -166,24 +167,24 @@ def trained_record(run: Path) -> tuple[float, float, float] | None:
 
 
 def train_all(jobs: list[tuple[Path, Path, Any]], workers: int, threads: int,
-              device: str = "cpu") -> dict[Path, tuple[float, float, float]]:
+              device: str = "cpu", graph: bool = False) -> dict[Path, tuple[float, float, float]]:
     """The training runs of ``jobs`` (dataset, run directory, config), ``workers`` at a time in
     spawned processes (training is single-threaded at these sizes: processes use the cores; on a
     GPU the runs share it, each launching its own small kernels)."""
     if workers <= 1 or len(jobs) <= 1:
-        return {run: train_run(dataset, run, config, threads, device) for dataset, run, config in jobs}
+        return {run: train_run(dataset, run, config, threads, device, graph) for dataset, run, config in jobs}
     import multiprocessing
     from concurrent.futures import ProcessPoolExecutor
 
     spawn = multiprocessing.get_context("spawn")
     with ProcessPoolExecutor(min(workers, len(jobs)), mp_context=spawn) as pool:
-        futures = {run: pool.submit(train_run, dataset, run, config, threads, device)
+        futures = {run: pool.submit(train_run, dataset, run, config, threads, device, graph)
                    for dataset, run, config in jobs}
         return {run: future.result() for run, future in futures.items()}
 
 
 def budget_steps(jobs: list[tuple[Path, Path, Any]], budget: float, work: Path, workers: int, threads: int,
-                 device: str, probe_steps: int = PROBE_STEPS) -> int:
+                 device: str, probe_steps: int = PROBE_STEPS, graph: bool = False) -> int:
     """The training steps per run that fit ``budget`` seconds when ``jobs`` are trained ``workers``
     at a time: that many of them train ``probe_steps`` steps (warm-up included, so the estimate errs
     short) into a scratch directory at the same time; the slowest sets the rate, and the runs take
@@ -196,7 +197,7 @@ def budget_steps(jobs: list[tuple[Path, Path, Any]], budget: float, work: Path, 
     shutil.rmtree(scratch, ignore_errors=True)
     probes = [(dataset, scratch / f"{i}", replace(config, steps=probe_steps, checkpoint_every=probe_steps))
               for i, (dataset, _, config) in enumerate(jobs[:at_once])]
-    timings = train_all(probes, at_once, threads, device)
+    timings = train_all(probes, at_once, threads, device, graph)
     shutil.rmtree(scratch, ignore_errors=True)
     rate = min(probe_steps / seconds for seconds, _, _ in timings.values())
     steps = max(1000, int(rate * budget / turns) // 1000 * 1000)
@@ -220,7 +221,7 @@ def train_and_evaluate(task: str, method: str, dataset: Path, env_config: dict[s
         raise SystemExit(f"{run} holds no finished training run: run --stage train first (or --import the "
                          "checkpoints trained elsewhere)")
     seconds, rate, loss = trained or train_run(dataset, run, train_config(args, train_seed), args.threads,
-                                               args.device)
+                                               args.device, args.cuda_graph)
     evaluation = evaluate(run, len(scenes), seed=0, max_steps=args.max_steps, env_config=env_config,
                           threads=args.threads, make_env=functools.partial(make_env, scenes=scenes),
                           workers=args.workers, batch=args.eval_batch)
@@ -403,6 +404,8 @@ def main() -> None:
     parser.add_argument("--stage", choices=("all", "data", "train", "evaluate"), default="all",
                         help="run one stage only (see the module's help); default: all three")
     parser.add_argument("--device", default="cpu", help="training device: cpu, or cuda on a GPU machine")
+    parser.add_argument("--cuda-graph", action="store_true",
+                        help="with --device cuda: capture each run's training step as a CUDA graph")
     parser.add_argument("--budget", type=float, default=None,
                         help="train stage: pick --steps to fit this many seconds (a probe times all runs)")
     parser.add_argument("--probe-steps", type=int, default=PROBE_STEPS,
@@ -528,9 +531,9 @@ def train_stage(tasks: list[str], args: argparse.Namespace) -> None:
     if pending and args.budget is not None:  # the steps that fit the budget, the same for every run
         probes = [(datasets[t, m], run_dir(args.work, t, m, s), train_config(args, s)) for t, m, s in pending]
         args.steps = budget_steps(probes, args.budget, args.work, args.workers, args.threads, args.device,
-                                  args.probe_steps)
+                                  args.probe_steps, args.cuda_graph)
     jobs = [(datasets[t, m], run_dir(args.work, t, m, s), train_config(args, s)) for t, m, s in pending]
-    trained = train_all(jobs, args.workers, args.threads, args.device)
+    trained = train_all(jobs, args.workers, args.threads, args.device, args.cuda_graph)
     for (t, m, s), (_, run, config) in zip(pending, jobs, strict=True):
         seconds, rate, loss = trained[run]
         print(f"  {t}: {m:8s} seed {s}: {config.steps} steps in {seconds:.0f} s ({rate:.0f} samples/s, "
@@ -553,7 +556,7 @@ def evaluate_stage(task: str, args: argparse.Namespace, datasets: dict[str, Path
     trained: dict[Path, tuple[float, float, float]] = {}
     if args.stage != "evaluate":
         jobs = [(datasets[m], run_dir(args.work, task, m, s), train_config(args, s)) for m, s in pending]
-        trained = train_all(jobs, args.workers, args.threads, args.device)
+        trained = train_all(jobs, args.workers, args.threads, args.device, args.cuda_graph)
     results = []
     for _, method, train_seed in runs:
         r = train_and_evaluate(task, method, datasets[method], env_config, scenes, train_seed, args,

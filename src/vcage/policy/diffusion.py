@@ -37,10 +37,13 @@ class NoiseSchedule:
         self.inference_steps = inference_steps
         self.clip_sample = clip_sample
         self.alphas_cumprod = cosine_alphas_cumprod(train_timesteps)
+        self._on: dict[torch.device, torch.Tensor] = {}  # copies on other devices (a CUDA graph copies none)
 
     def add_noise(self, x0: torch.Tensor, noise: torch.Tensor, t: torch.Tensor) -> torch.Tensor:
         """x_t = sqrt(alpha_bar_t) x0 + sqrt(1 - alpha_bar_t) noise, per sample of the batch."""
-        ab = self.alphas_cumprod.to(x0.device)[t].to(x0.dtype).view(-1, *([1] * (x0.dim() - 1)))
+        if x0.device not in self._on:
+            self._on[x0.device] = self.alphas_cumprod.to(x0.device)
+        ab = self._on[x0.device][t].to(x0.dtype).view(-1, *([1] * (x0.dim() - 1)))
         return ab.sqrt() * x0 + (1 - ab).sqrt() * noise
 
     def inference_timesteps(self) -> list[int]:

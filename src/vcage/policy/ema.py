@@ -20,19 +20,31 @@ class Ema:
     def decay(self) -> float:
         return min(self.max_decay, max(0.0, 1 - (1 + self.updates) ** -self.power))
 
-    @torch.no_grad()
     def update(self, model: nn.Module) -> None:
-        decay = self.decay()
+        """Average ``model``'s weights in with :meth:`decay`, and count the update."""
+        self.average(model)
+        self.updates += 1
+
+    @torch.no_grad()
+    def average(self, model: nn.Module, decay: torch.Tensor | None = None) -> None:
+        """Average ``model``'s weights in, without counting. ``decay``, a 0-d tensor on the model's
+        device, replaces :meth:`decay` inside a CUDA graph (which replays kernels, so the number must
+        live in memory the host refills before each replay); the caller keeps it equal to
+        :meth:`decay` and counts the update."""
         averaged: list[torch.Tensor] = list(self.model.parameters())
         current: list[torch.Tensor] = [p.detach() for p in model.parameters()]
         if len(averaged) != len(current):
             raise ValueError(f"the EMA holds {len(averaged)} parameters, the model {len(current)}")
         # one kernel per operation for all parameters (on a GPU, a loop launches two per parameter)
-        torch._foreach_mul_(averaged, decay)
-        torch._foreach_add_(averaged, current, alpha=1 - decay)
+        if decay is None:
+            value = self.decay()
+            torch._foreach_mul_(averaged, value)
+            torch._foreach_add_(averaged, current, alpha=1 - value)
+        else:
+            torch._foreach_mul_(averaged, decay)
+            torch._foreach_add_(averaged, torch._foreach_mul(current, 1 - decay))
         for kept, buffer in zip(self.model.buffers(), model.buffers(), strict=True):
             kept.copy_(buffer)
-        self.updates += 1
 
     def state_dict(self) -> dict[str, object]:
         return {"model": self.model.state_dict(), "updates": self.updates}

@@ -27,6 +27,17 @@ class Policy(nn.Module):
         self.config, self.obs_dim, self.action_dim = config, obs_dim, action_dim
 
     def loss(self, obs: torch.Tensor, action: torch.Tensor, generator: torch.Generator) -> torch.Tensor:
+        return self.loss_from(obs, action, *self.draws(action.shape, generator, action.device))
+
+    def draws(self, shape: torch.Size | tuple[int, ...], generator: torch.Generator,
+              device: torch.device) -> tuple[torch.Tensor, ...]:
+        """The random inputs of one batch's loss, for an action batch of ``shape``, drawn from the
+        (CPU) ``generator`` and put on ``device`` (none by default)."""
+        return ()
+
+    def loss_from(self, obs: torch.Tensor, action: torch.Tensor, *draws: torch.Tensor) -> torch.Tensor:
+        """The training objective of one batch given its random inputs (:meth:`draws`): what a
+        CUDA graph of the training step captures, the draws being copied in before each replay."""
         raise NotImplementedError
 
     def predict(self, obs: torch.Tensor, generator: torch.Generator) -> torch.Tensor:
@@ -62,10 +73,15 @@ class DiffusionPolicy(Policy):
                                       d.n_groups, d.step_embed_dim)
         self.schedule = NoiseSchedule(d.train_timesteps, d.inference_steps, d.clip_sample)
 
-    def loss(self, obs: torch.Tensor, action: torch.Tensor, generator: torch.Generator) -> torch.Tensor:
-        noise = randn(tuple(action.shape), generator, action)
-        t = torch.randint(0, self.schedule.train_timesteps, (action.shape[0],), generator=generator)
-        t = t.to(action.device)
+    def draws(self, shape: torch.Size | tuple[int, ...], generator: torch.Generator,
+              device: torch.device) -> tuple[torch.Tensor, ...]:
+        """The noise added to the chunk and the diffusion step of each sample."""
+        noise = torch.randn(tuple(shape), generator=generator).to(device)
+        t = torch.randint(0, self.schedule.train_timesteps, (shape[0],), generator=generator)
+        return noise, t.to(device)
+
+    def loss_from(self, obs: torch.Tensor, action: torch.Tensor, *draws: torch.Tensor) -> torch.Tensor:
+        noise, t = draws
         noisy = self.schedule.add_noise(action, noise, t)
         return F.mse_loss(self.unet(noisy, t, obs.flatten(1)), noise)
 
@@ -96,7 +112,7 @@ class MlpPolicy(Policy):
     def forward(self, obs: torch.Tensor) -> torch.Tensor:
         return self.net(obs.flatten(1)).view(obs.shape[0], self.config.horizon, self.action_dim)
 
-    def loss(self, obs: torch.Tensor, action: torch.Tensor, generator: torch.Generator) -> torch.Tensor:
+    def loss_from(self, obs: torch.Tensor, action: torch.Tensor, *draws: torch.Tensor) -> torch.Tensor:
         return F.mse_loss(self(obs), action)
 
     @torch.no_grad()

@@ -36,6 +36,7 @@ from vcage.policy.dataset import TrainingData, load_training_data
 from vcage.policy.devices import torch_device
 from vcage.policy.ema import Ema
 from vcage.policy.errors import CheckpointError, PolicyError, TrainingDivergedError
+from vcage.policy.graphed import GraphedStep
 from vcage.policy.models import Policy, make_policy
 from vcage.policy.normalize import Normalizer
 from vcage.policy.sampler import BatchSampler
@@ -97,7 +98,7 @@ class Run:
     """The state of one training run: data tensors, model, EMA, optimiser, generators, sampler."""
 
     def __init__(self, data: TrainingData, config: TrainConfig, normalization: dict[str, Normalizer],
-                 device: torch.device) -> None:
+                 device: torch.device, graph: bool = False) -> None:
         self.data, self.config, self.normalization, self.device = data, config, normalization, device
         windows = make_windows(data.lengths, config.n_obs_steps, config.horizon)
         self.obs_index = torch.from_numpy(windows.obs)
@@ -108,18 +109,30 @@ class Run:
         self.model: Policy = make_policy(config, data.obs.shape[1], data.action.shape[1]).to(device)
         self.ema = Ema(self.model, config.ema_power, config.ema_max_decay)
         self.optimizer = torch.optim.AdamW(self.model.parameters(), lr=config.lr,
-                                           weight_decay=config.weight_decay)
+                                           weight_decay=config.weight_decay, capturable=graph)
         self.generator = torch.Generator().manual_seed(config.seed)
         self.sampler = BatchSampler(len(windows), config.batch_size, config.seed)
         self.step = 0
         self.losses: list[float] = []
+        self.graphed = GraphedStep(self) if graph else None  # captured at its first steps, after restore
 
     def batch(self) -> tuple[torch.Tensor, torch.Tensor]:
         rows = torch.from_numpy(self.sampler.next_batch())
         return self.obs[self.obs_index[rows]], self.action[self.action_index[rows]]
 
     def train_step(self) -> float:
-        """One optimiser step; TrainingDivergedError (before any weight changes) on a non-finite loss."""
+        """One optimiser step; TrainingDivergedError (before any weight changes, except in a CUDA
+        graph, where it comes after the step) on a non-finite loss or gradient norm."""
+        if self.graphed is not None:
+            lr, rows = learning_rate(self.config, self.step), self.sampler.next_batch()
+            draws = self.model.draws(self.graphed.shape, self.generator, torch.device("cpu"))
+            value, grad_norm = self.graphed.step(rows, draws, lr, self.ema.decay())
+            for what, number in (("loss", value), ("gradient norm", grad_norm)):
+                if not math.isfinite(number):
+                    raise TrainingDivergedError(f"the {what} became {number} at step {self.step + 1}")
+            self.step += 1
+            self.losses.append(value)
+            return value
         for group in self.optimizer.param_groups:
             group["lr"] = learning_rate(self.config, self.step)
         obs, action = self.batch()
@@ -147,7 +160,7 @@ class Run:
             "normalization": {k: v.to_dict() for k, v in self.normalization.items()},
             "step": self.step, "loss_history": torch.tensor(self.losses, dtype=torch.float64),
             "model": self.model.state_dict(), "ema": self.ema.state_dict(),
-            "optimizer": self.optimizer.state_dict(),
+            "optimizer": _plain_lr(self.optimizer.state_dict()),
             "rng": {"generator": self.generator.get_state(), "torch": torch.get_rng_state()},
             "sampler": self.sampler.state_dict(),
         }
@@ -161,6 +174,12 @@ class Run:
         self.sampler.load_state_dict(payload["sampler"])
         self.step = int(payload["step"])
         self.losses = [float(v) for v in payload["loss_history"].tolist()]
+
+
+def _plain_lr(state: dict[str, Any]) -> dict[str, Any]:
+    """An optimiser state whose learning rates are numbers (a CUDA graph keeps each in a tensor)."""
+    groups = [{**g, "lr": float(g["lr"])} for g in state["param_groups"]]
+    return {**state, "param_groups": groups}
 
 
 def config_differences(stored: TrainConfig, given: TrainConfig) -> list[str]:
@@ -194,9 +213,10 @@ def _resume_from(out: Path, config: TrainConfig, resume: bool) -> dict[str, Any]
 
 def train(dataset: str | Path, out: str | Path, config: TrainConfig, *, resume: bool = False,
           device: str = "cpu", threads: int | None = None, progress: Progress | None = None,
-          keep: int | None = None) -> TrainSummary:
+          keep: int | None = None, graph: bool = False) -> TrainSummary:
     """Train ``config.policy`` on ``dataset``, writing checkpoints to ``out/checkpoints/`` (only the
     ``keep`` newest stay, if given: a new one is written before older ones are deleted).
+    ``graph`` captures the step as a CUDA graph (:mod:`vcage.policy.graphed`; CUDA devices only).
 
     With ``resume``, continue from the latest checkpoint in ``out`` (a fresh start if there is
     none). A non-finite loss stops the run with :class:`TrainingDivergedError`; the checkpoints
@@ -217,7 +237,9 @@ def train(dataset: str | Path, out: str | Path, config: TrainConfig, *, resume: 
         normalization = {"obs": Normalizer.fit(data.obs, config.obs_norm),
                          "action": Normalizer.fit(data.action, "min_max")}
     with deterministic(threads, where):
-        run = Run(data, config, normalization, where)
+        if graph and where.type != "cuda":
+            raise ConfigError(f"a CUDA graph of the training step needs a CUDA device, not {device!r}")
+        run = Run(data, config, normalization, where, graph)
         if saved is not None:
             run.restore(saved)
         start, last_saved = run.step, (checkpoint_path(out, run.step) if saved is not None else None)
