@@ -74,6 +74,8 @@ def test_bad_input_exits_2_with_the_reason(generated: Path, tmp_path: Path) -> N
     assert lacking.exit_code == 2 and f"vcage backfill {bare}" in flat(lacking.output)
     wrong = RUN.invoke(app, ["train", str(generated), "--out", str(tmp_path / "run"), "--policy", "gpt"])
     assert wrong.exit_code == 2 and "valid: diffusion, mlp" in flat(wrong.output)
+    graph = RUN.invoke(app, ["train", str(generated), "--out", str(tmp_path / "run"), "--cuda-graph"])
+    assert graph.exit_code == 2 and "needs a CUDA device, not 'cpu'" in flat(graph.output)
     assert not (tmp_path / "run").exists()
 
 
