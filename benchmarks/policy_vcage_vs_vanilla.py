@@ -331,6 +331,27 @@ def report(results: list[dict[str, Any]], noise: dict[str, float], draws: int) -
         if len(paired) >= 3 and np.std(gaps) > 0 and np.std(noises) > 0:
             corr = np.corrcoef(gaps, noises)[0, 1]
             print(f"correlation of the per-task gap with Vanilla's label noise: {corr:+.2f}")
+        subtask_gaps(by, paired, draws)
+
+
+def subtask_gaps(by: dict[str, dict[str, list[dict[str, Any]]]], paired: dict[str, Any], draws: int) -> None:
+    """For each goal of several subtasks: how many held-out episodes got past each subtask, per
+    method, and the paired bootstrap interval of the gap (a goal no policy completes can still
+    show which data teaches its first steps)."""
+    rng = np.random.default_rng(1)
+    for task in paired:
+        names = by[task]["vcage"][0].get("subtask_names") or []
+        if len(names) < 2:
+            continue
+        print(f"\n{task}: episodes past each subtask (V-CAGE, Vanilla; gap with its paired bootstrap 95%)")
+        for k, name in enumerate(names):
+            done = {m: np.array([[e["subtasks_done"] > k for e in r["per_episode"]]
+                                 for r in sorted(by[task][m], key=lambda r: r["train_seed"])], dtype=float)
+                    for m in METHODS}
+            gap, low, high = bootstrap_gap({task: done}, draws, rng)
+            print(f"  {k + 1}. {name[:56]:56s} {int(done['vcage'].sum()):4d}/{done['vcage'].size:<4d} "
+                  f"{int(done['vanilla'].sum()):4d}/{done['vanilla'].size:<4d} {gap:+.1%} "
+                  f"[{low:+.1%}, {high:+.1%}]")
 
 
 def export_name(task: str, method: str, train_seed: int) -> str:

@@ -13,6 +13,7 @@ import subprocess
 import sys
 from pathlib import Path
 from types import ModuleType
+from typing import Any
 
 from conftest import blocked_modules
 
@@ -81,7 +82,7 @@ def _experiment() -> ModuleType:
 def test_failure_kinds_count_what_the_oracle_finds_wrong_in_kept_demos(tmp_path: Path) -> None:
     """Each kept episode that fails the oracle counts once per failed predicate (and per skill error);
     kept successes and rejected attempts count for nothing."""
-    def record(stage: str, success: bool, rows: list[dict[str, object]]) -> str:
+    def record(stage: str, success: bool, rows: list[dict[str, Any]]) -> str:
         return json.dumps({"stage": stage, "oracle_success": success, "audit": rows})
 
     on_false = {"skill": "pick_and_place", "oracle": {"on(mouse, pad)": False, "released(mouse)": True}}
@@ -99,3 +100,20 @@ def test_failure_kinds_count_what_the_oracle_finds_wrong_in_kept_demos(tmp_path:
     kinds = _experiment().failure_kinds(tmp_path)
     assert kinds == {"on(mouse, pad)": 2, "pressed(bell)": 1, "upright(bell)": 1, "skill error in press": 1}
     assert next(iter(kinds)) == "on(mouse, pad)"  # most frequent first
+
+
+def test_subtask_gaps_count_the_episodes_past_each_subtask(capsys: object) -> None:
+    """A goal no policy completes still shows which data teaches its first subtask."""
+    def result(method: str, seed: int, done: list[int]) -> dict[str, object]:
+        return {"method": method, "train_seed": seed, "subtask_names": ["the mouse on the pad", "the bell"],
+                "per_episode": [{"subtasks_done": d, "success": d == 2} for d in done]}
+
+    by = {"goal": {"vcage": [result("vcage", 1, [1, 1, 0, 2]), result("vcage", 0, [1, 0, 0, 0])],
+                   "vanilla": [result("vanilla", 0, [0, 0, 0, 0]), result("vanilla", 1, [1, 0, 0, 0])]},
+          "one step": {"vcage": [{"subtask_names": ["only"], "per_episode": []}]}}
+    _experiment().subtask_gaps(by, {"goal": None, "one step": None}, draws=200)
+    out = capsys.readouterr().out  # type: ignore[attr-defined]
+    first, second = (line.split() for line in out.splitlines() if line.strip()[:2] in ("1.", "2."))
+    assert first[-5:-2] == ["4/8", "1/8", "+37.5%"]  # V-CAGE past the first, Vanilla past it, the gap
+    assert second[-5:-2] == ["1/8", "0/8", "+12.5%"]
+    assert "one step" not in out  # a single subtask has nothing to add to the success rate
