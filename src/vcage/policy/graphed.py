@@ -2,9 +2,9 @@
 
 On a GPU, one step of the diffusion U-Net launches thousands of small kernels (convolutions, group
 norms, the optimiser's and the EMA's per-tensor updates), so its time is the launches' whatever the
-batch: a lent H200 ran 18.6 steps per second alone at batch 256 and at 1,024 alike, and twenty runs
-sharing it about 3 each (``docs/BENCHMARKS.md``). A CUDA graph records the step's kernels once and
-replays them with one launch.
+batch: a lent H200 ran one run alone at 20.0 steps per second at batch 256 and 21.4 at 1,024, and
+twenty runs sharing it at 3.2-3.6 each (``docs/BENCHMARKS.md``). A CUDA graph records the step's
+kernels once and replays them with one launch.
 
 What changes from step to step is copied into fixed device buffers before each replay: the batch's
 window indices, the diffusion noise and steps (drawn on the CPU from the run's generator, as in the
