@@ -146,7 +146,7 @@ class Catalog(Registry[ObjectType]):
 
     def with_point(self, kind: str) -> list[str]:
         """The names of the types with a functional point of ``kind`` (a loop, a hook)."""
-        return [o.name for o in self.values() if o.point_of_kind(kind) is not None]
+        return self.names_where(lambda o: o.point_of_kind(kind) is not None)
 
 
 CATALOG = Catalog()
