@@ -62,9 +62,9 @@ def test_the_runner_predicts_every_eight_steps_from_a_two_frame_window(checkpoin
     seen: list[torch.Tensor] = []
     chunk = torch.arange(16 * 8, dtype=torch.float32).reshape(1, 16, 8) / 100
 
-    def predict_from(obs: torch.Tensor, noise: torch.Tensor) -> torch.Tensor:
+    def predict_from(obs: torch.Tensor, noise: torch.Tensor, subtask: torch.Tensor | None) -> torch.Tensor:
         seen.append(obs.clone())
-        assert noise.shape == (1, 16, 8)
+        assert noise.shape == (1, 16, 8) and subtask is None  # an unconditioned policy gets no subtask
         return chunk
 
     runner.model.predict_from = predict_from  # type: ignore[method-assign]

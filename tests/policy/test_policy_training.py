@@ -147,9 +147,9 @@ def test_a_nan_loss_stops_training_and_keeps_the_last_good_checkpoint(
     calls = {"n": 0}
 
     def diverging(self: MlpPolicy, obs: torch.Tensor, action: torch.Tensor,
-                  g: torch.Generator) -> torch.Tensor:
+                  g: torch.Generator, subtask: torch.Tensor | None = None) -> torch.Tensor:
         calls["n"] += 1
-        loss = real(self, obs, action, g)
+        loss = real(self, obs, action, g, subtask)
         if calls["n"] != 13:
             return loss
         if what == "loss":

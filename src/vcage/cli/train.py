@@ -37,6 +37,10 @@ def train_cmd(
                                              "(default: all; each is about 20 MB at the default sizes)"),
         resume: bool = typer.Option(False, help="continue the run in OUT from its last checkpoint (only "
                                     "--steps may change)"),
+        subtask_conditioned: bool = typer.Option(None, "--subtask-conditioned/--no-subtask-conditioned",
+                                                 help="hierarchical: condition the policy on the plan's "
+                                                 "subtask, which a classifier head names from the "
+                                                 "observation during evaluation (needs subtask_index)"),
         down_dims: str = typer.Option(None, help="the diffusion U-Net's channels per level, comma-separated "
                                       "(default 32,64,128)"),
         export: Path = typer.Option(None, help="also write the final checkpoint for evaluation only (EMA "
@@ -54,7 +58,7 @@ def train_cmd(
 
     given: dict[str, Any] = {"policy": policy, "steps": steps, "batch_size": batch_size, "lr": lr,
                              "seed": seed, "checkpoint_every": checkpoint_every, "rotations": rotations,
-                             "action_key": action,
+                             "action_key": action, "subtask_conditioned": subtask_conditioned,
                              "observation_keys": split_keys(obs) if obs else None}
     given = {k: v for k, v in given.items() if v is not None}
     base = stored_config(out) if resume else None

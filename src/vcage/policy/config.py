@@ -29,6 +29,9 @@ ACTION = "action"
 # (``action.ee_pose``, which the evaluation environment turns into joint targets by IK); the same as
 # vcage.pipeline.features.ACTIONS, which this module cannot import (training loads no simulator).
 ACTIONS = (ACTION, "action.ee_pose")
+# The per-frame subtask of a plan's episode (vcage.pipeline.features.SUBTASK), which a
+# subtask-conditioned policy learns to recognise
+SUBTASK = "subtask_index"
 # An observation key: a feature's name, or its name and some of its elements by name in brackets
 # (``observation.state[gripper_width]``), which the policy then observes alone, in the order given
 _KEY = re.compile(r"([^\[\],\s]+)(?:\[([^\[\]]+)\])?")
@@ -126,6 +129,10 @@ class TrainConfig:
     n_action_steps: int = 8
     ema_power: float = 0.75  # EMA decay 1 - (1 + step) ** -power, at most ema_max_decay
     ema_max_decay: float = 0.9999
+    # Hierarchical: a classifier head names the plan's subtask from the observation window and the
+    # action model is conditioned on it (training: on the demonstration's subtask_index; inference:
+    # on the classifier's answer, which never goes back to an earlier subtask within an episode)
+    subtask_conditioned: bool = False
     diffusion: DiffusionConfig = field(default_factory=DiffusionConfig)
     mlp: MlpConfig = field(default_factory=MlpConfig)
 
@@ -142,6 +149,8 @@ class TrainConfig:
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, int) or value < 1:
                 raise ConfigError(f"{name} must be a positive integer, got {value!r}")
+        if not isinstance(self.subtask_conditioned, bool):
+            raise ConfigError(f"subtask_conditioned must be true or false, got {self.subtask_conditioned!r}")
         if isinstance(self.seed, bool) or not isinstance(self.seed, int) or self.seed < 0:
             raise ConfigError(f"seed must be a non-negative integer, got {self.seed!r}")
         if isinstance(self.warmup_steps, bool) or not isinstance(self.warmup_steps, int) \
@@ -161,9 +170,11 @@ class TrainConfig:
                               f"{2 ** (len(self.diffusion.down_dims) - 1)} for the U-Net's down-sampling")
         if self.observation_keys is not None:
             keys = tuple(str(k).strip() for k in self.observation_keys)
-            if not keys or len(set(keys)) != len(keys) or {split_key(k)[0] for k in keys} & set(ACTIONS):
+            reserved = {*ACTIONS, SUBTASK}
+            if not keys or len(set(keys)) != len(keys) or {split_key(k)[0] for k in keys} & reserved:
                 raise ConfigError(f"observation_keys must be distinct feature names (or "
-                                  f"FEATURE[ELEMENT,...]) other than the actions {', '.join(ACTIONS)}, got "
+                                  f"FEATURE[ELEMENT,...]) other than the actions {', '.join(ACTIONS)} and "
+                                  f"{SUBTASK} (which subtask_conditioned uses), got "
                                   f"{self.observation_keys!r}")
             object.__setattr__(self, "observation_keys", keys)
 

@@ -15,7 +15,7 @@ import numpy as np
 
 from vcage.data.reader import DatasetReader
 from vcage.errors import DatasetError
-from vcage.policy.config import DEFAULT_OBSERVATIONS, REQUIRED_OBSERVATIONS, TrainConfig, split_key
+from vcage.policy.config import DEFAULT_OBSERVATIONS, REQUIRED_OBSERVATIONS, SUBTASK, TrainConfig, split_key
 from vcage.policy.encoding import VectorEncoder
 from vcage.policy.errors import MissingFeatureError
 
@@ -82,7 +82,8 @@ class TrainingData:
     """All frames of a dataset: ``obs`` (N, obs_dim) float32 (the features of ``obs_features``
     side by side, as :class:`VectorEncoder` gives them to the policy), ``action``
     (N, action_dim) float32 (the feature ``action_feature`` encoded the same way), ``lengths`` of
-    the episodes in order."""
+    the episodes in order; for a subtask-conditioned policy, ``subtask`` (N,) int64, the plan's
+    subtask of each frame, of which there are ``subtasks``."""
 
     obs: np.ndarray
     action: np.ndarray
@@ -91,6 +92,8 @@ class TrainingData:
     action_feature: FeatureSpec
     info: DatasetInfo
     notes: tuple[str, ...] = field(default=())  # things the user should know (e.g. a feature left out)
+    subtask: np.ndarray | None = None
+    subtasks: int = 0
 
 
 def fingerprint(reader: DatasetReader) -> str:
@@ -137,23 +140,35 @@ def load_training_data(root: str | Path, config: TrainConfig) -> TrainingData:
         raise MissingFeatureError(
             f"the dataset {reader.root} has no feature {config.action_key!r} to train on (it has "
             f"{', '.join(sorted(reader.features))}); run `vcage backfill {reader.root}` to add it")
+    if config.subtask_conditioned and SUBTASK not in reader.features:
+        raise MissingFeatureError(
+            f"a subtask-conditioned policy learns from each frame's {SUBTASK!r}, which the dataset "
+            f"{reader.root} lacks; run `vcage backfill {reader.root}` to add it (a dataset of a plan), or "
+            "train without --subtask-conditioned")
     keys, notes = observation_keys(reader, config.observation_keys)
     specs = tuple(_spec(reader, k) for k in keys)
     obs_parts: list[list[np.ndarray]] = [[] for _ in keys]
-    actions, lengths = [], []
+    actions, lengths, subtask = [], [], []
     for i in range(reader.num_episodes):
         frames = reader.episode(i).frames
         for part, spec in zip(obs_parts, specs, strict=True):
             part.append(spec.select(_vectors(frames[spec.feature], spec.feature, i, reader.root)))
         actions.append(_vectors(frames[config.action_key], config.action_key, i, reader.root))
         lengths.append(len(actions[-1]))
+        if config.subtask_conditioned:
+            subtask.append(_subtasks(frames[SUBTASK], i, reader.root))
     raw = np.concatenate([np.concatenate(p) for p in obs_parts], axis=1)
     obs = VectorEncoder(specs, config.rotations)(raw)
     action_spec = _spec(reader, config.action_key)
     action = VectorEncoder([action_spec], config.rotations)(np.concatenate(actions))
     info = DatasetInfo(str(reader.root), fingerprint(reader), reader.fps, reader.num_episodes,
                        reader.total_frames, reader.config)
-    return TrainingData(obs, action, tuple(lengths), specs, action_spec, info, tuple(notes))
+    labels = np.concatenate(subtask) if subtask else None
+    count = int(labels.max()) + 1 if labels is not None else 0
+    if labels is not None and count < 2:
+        notes.append(f"every frame of {reader.root} belongs to subtask 0: conditioning on the subtask tells "
+                     "the policy nothing")
+    return TrainingData(obs, action, tuple(lengths), specs, action_spec, info, tuple(notes), labels, count)
 
 
 def _spec(reader: DatasetReader, key: str) -> FeatureSpec:
@@ -168,6 +183,16 @@ def _spec(reader: DatasetReader, key: str) -> FeatureSpec:
                                   f"{', '.join(missing)} (it has {', '.join(names or ('no names',))})")
     assert names is not None
     return FeatureSpec(key, len(elements), elements, source, tuple(names.index(e) for e in elements))
+
+
+def _subtasks(values: np.ndarray, episode: int, root: Path) -> np.ndarray:
+    """An episode's per-frame subtask indices, checked: whole numbers from 0, never decreasing."""
+    x = np.asarray(values).reshape(-1)
+    if len(x) and (not np.all(np.isfinite(x)) or np.any(x < 0) or np.any(x != np.round(x))
+                   or np.any(np.diff(x) < 0)):
+        raise DatasetError(f"{root}: {SUBTASK!r} of episode {episode} is not a non-decreasing sequence of "
+                           "subtask numbers from 0; `vcage backfill` the dataset again")
+    return x.astype(np.int64)
 
 
 def _vectors(values: np.ndarray, key: str, episode: int, root: Path) -> np.ndarray:

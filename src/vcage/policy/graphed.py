@@ -83,8 +83,8 @@ class GraphedStep:
 
     def _body(self) -> tuple[torch.Tensor, torch.Tensor]:
         run = self.run
-        obs, action = run.obs[self.obs_index[self.rows]], run.action[self.action_index[self.rows]]
-        loss = run.model.loss_from(obs, action, *self.draws)
+        obs, action, subtask = run.gather(self.rows, self.obs_index, self.action_index)
+        loss = run.model.loss_from(obs, action, *self.draws, subtask=subtask)
         loss.backward()
         norm = torch.nn.utils.clip_grad_norm_(run.model.parameters(), run.config.grad_clip, foreach=True)
         run.optimizer.step()

@@ -4,6 +4,12 @@ The runner keeps the last ``n_obs_steps`` observations (the first one repeated a
 training pads the start of an episode) and a queue of actions: when the queue is empty it predicts
 a chunk of ``horizon`` actions from the window and queues the ``n_action_steps`` starting at the
 current frame (index ``n_obs_steps - 1`` of the chunk), as Diffusion Policy executes them.
+
+A subtask-conditioned policy also keeps the subtask it is in: before each chunk its classifier
+names the subtask of the window, and the runner moves on to it if it is a later one. It never goes
+back within an episode: a plan's subtasks are done in order, and a state in which an earlier
+subtask's goal holds again (the mouse still on its pad while the bell is pressed) should not send
+the arm back to it.
 """
 
 from __future__ import annotations
@@ -36,7 +42,8 @@ class PolicyRunner:
         self.device = torch.device(device)
         self.encoder = VectorEncoder(self.obs_features, self.config.rotations)
         self.action_encoder = VectorEncoder([self.action_feature], self.config.rotations)
-        self.model: Policy = make_policy(self.config, self.encoder.size, self.action_encoder.size)
+        self.model: Policy = make_policy(self.config, self.encoder.size, self.action_encoder.size,
+                                         int(checkpoint.get("subtasks", 0)))
         try:
             self.model.load_state_dict(checkpoint["ema"]["model"])
         except (RuntimeError, KeyError, TypeError) as exc:
@@ -46,6 +53,7 @@ class PolicyRunner:
         self.generator = torch.Generator().manual_seed(seed)
         self._window: deque[np.ndarray] = deque(maxlen=self.config.n_obs_steps)
         self._queue: deque[np.ndarray] = deque()
+        self.subtask = 0  # the subtask a subtask-conditioned policy is in (always 0 for others)
 
     @property
     def observation_keys(self) -> tuple[str, ...]:
@@ -56,6 +64,7 @@ class PolicyRunner:
         ``seed`` restarts the sampler's noise, so an episode does not depend on the ones before."""
         self._window.clear()
         self._queue.clear()
+        self.subtask = 0
         if seed is not None:
             self.generator.manual_seed(seed)
 
@@ -97,7 +106,14 @@ def act_together(runners: Sequence[PolicyRunner],
         windows = torch.from_numpy(np.stack([np.stack(r._window) for r in due])).to(lead.device)
         shape = (1, lead.config.horizon, lead.action_encoder.size)
         noise = torch.cat([randn(shape, r.generator, windows) for r in due])
-        chunks = lead.model.predict_from(windows, noise).cpu().numpy()
+        subtask = None
+        if lead.model.subtasks:
+            with torch.no_grad():
+                named = lead.model.classify(windows).argmax(dim=1).tolist()
+            for runner, k in zip(due, named, strict=True):
+                runner.subtask = max(runner.subtask, int(k))
+            subtask = torch.tensor([r.subtask for r in due], device=lead.device)
+        chunks = lead.model.predict_from(windows, noise, subtask).cpu().numpy()
         for runner, chunk in zip(due, chunks, strict=True):
             runner._queue_chunk(chunk)
     return [r._queue.popleft() for r in runners]

@@ -4,6 +4,14 @@ Both map a normalised observation window (B, n_obs, obs_dim) to a normalised act
 (B, horizon, action_dim). ``loss`` is the training objective of one batch; ``predict`` the chunk
 at inference. Randomness comes only from the ``generator`` passed in (noise is drawn on the CPU,
 so a seed gives the same draws on any device).
+
+A policy of a plan's dataset can be conditioned on the plan's subtask (``subtasks`` > 0): its
+action model then reads the subtask as a one-hot vector beside the observation window, and a
+classifier head learns to name the subtask from the window (cross-entropy, added to the loss).
+Training conditions on the demonstration's subtask; at inference the runner asks the classifier
+(:mod:`vcage.policy.inference`). Without it, a state where one subtask has ended looks much like
+the one the episode began in (the arm back at its start, the gripper open), and a policy was seen
+to do the first subtask again instead of the next (``docs/BENCHMARKS.md``).
 """
 
 from __future__ import annotations
@@ -18,16 +26,56 @@ from vcage.policy.diffusion import NoiseSchedule
 from vcage.policy.unet import ConditionalUnet1D
 from vcage.registry import Registry
 
+SUBTASK_HIDDEN = (256, 256)  # the subtask classifier's hidden layers
+
 
 class Policy(nn.Module):
-    """Observation window -> action chunk, both normalised."""
+    """Observation window -> action chunk, both normalised; with ``subtasks`` > 0, also conditioned
+    on the plan's subtask, which :meth:`classify` names from the window."""
 
-    def __init__(self, config: TrainConfig, obs_dim: int, action_dim: int) -> None:
+    def __init__(self, config: TrainConfig, obs_dim: int, action_dim: int, subtasks: int = 0) -> None:
         super().__init__()
-        self.config, self.obs_dim, self.action_dim = config, obs_dim, action_dim
+        self.config, self.obs_dim, self.action_dim, self.subtasks = config, obs_dim, action_dim, subtasks
+        self.subtask_head: nn.Module | None = None
+        if subtasks:
+            sizes = [obs_dim * config.n_obs_steps, *SUBTASK_HIDDEN]
+            layers: list[nn.Module] = []
+            for i, o in zip(sizes[:-1], sizes[1:], strict=True):
+                layers += [nn.Linear(i, o), nn.ReLU()]
+            self.subtask_head = nn.Sequential(*layers, nn.Linear(sizes[-1], subtasks))
 
-    def loss(self, obs: torch.Tensor, action: torch.Tensor, generator: torch.Generator) -> torch.Tensor:
-        return self.loss_from(obs, action, *self.draws(action.shape, generator, action.device))
+    @property
+    def cond_dim(self) -> int:
+        """The size of what the action model is conditioned on: the flattened window and the subtask."""
+        return self.obs_dim * self.config.n_obs_steps + self.subtasks
+
+    def condition(self, obs: torch.Tensor, subtask: torch.Tensor | None) -> torch.Tensor:
+        """The action model's conditioning: the flattened window, and the subtask as one-hot."""
+        flat = obs.flatten(1)
+        if not self.subtasks:
+            return flat
+        if subtask is None:
+            raise ValueError("a subtask-conditioned policy needs the subtask of every sample")
+        return torch.cat([flat, F.one_hot(subtask, self.subtasks).to(flat.dtype)], dim=1)
+
+    def classify(self, obs: torch.Tensor) -> torch.Tensor:
+        """Logits (B, subtasks) of the subtask each observation window is in."""
+        if self.subtask_head is None:
+            raise ValueError("this policy is not conditioned on the subtask")
+        return self.subtask_head(obs.flatten(1))
+
+    def subtask_loss(self, obs: torch.Tensor, subtask: torch.Tensor | None) -> torch.Tensor | float:
+        """The classifier's cross-entropy on the batch's subtasks (0 without a classifier)."""
+        if self.subtask_head is None:
+            return 0.0
+        if subtask is None:
+            raise ValueError("a subtask-conditioned policy needs the subtask of every sample")
+        return F.cross_entropy(self.classify(obs), subtask)
+
+    def loss(self, obs: torch.Tensor, action: torch.Tensor, generator: torch.Generator,
+             subtask: torch.Tensor | None = None) -> torch.Tensor:
+        draws = self.draws(action.shape, generator, action.device)
+        return self.loss_from(obs, action, *draws, subtask=subtask)
 
     def draws(self, shape: torch.Size | tuple[int, ...], generator: torch.Generator,
               device: torch.device) -> tuple[torch.Tensor, ...]:
@@ -35,25 +83,29 @@ class Policy(nn.Module):
         (CPU) ``generator`` and put on ``device`` (none by default)."""
         return ()
 
-    def loss_from(self, obs: torch.Tensor, action: torch.Tensor, *draws: torch.Tensor) -> torch.Tensor:
+    def loss_from(self, obs: torch.Tensor, action: torch.Tensor, *draws: torch.Tensor,
+                  subtask: torch.Tensor | None = None) -> torch.Tensor:
         """The training objective of one batch given its random inputs (:meth:`draws`): what a
         CUDA graph of the training step captures, the draws being copied in before each replay."""
         raise NotImplementedError
 
-    def predict(self, obs: torch.Tensor, generator: torch.Generator) -> torch.Tensor:
+    def predict(self, obs: torch.Tensor, generator: torch.Generator,
+                subtask: torch.Tensor | None = None) -> torch.Tensor:
         raise NotImplementedError
 
-    def predict_from(self, obs: torch.Tensor, noise: torch.Tensor) -> torch.Tensor:
-        """The chunk for ``obs`` starting from the given initial noise (B, horizon, action_dim), so
-        that each sample of a batch can draw its noise from its own generator."""
+    def predict_from(self, obs: torch.Tensor, noise: torch.Tensor,
+                     subtask: torch.Tensor | None = None) -> torch.Tensor:
+        """The chunk for ``obs`` (in ``subtask``, for a subtask-conditioned policy) starting from the
+        given initial noise (B, horizon, action_dim), so that each sample of a batch can draw its
+        noise from its own generator."""
         raise NotImplementedError
 
 
 POLICIES: Registry[type[Policy]] = Registry("policy", error=ConfigError)
 
 
-def make_policy(config: TrainConfig, obs_dim: int, action_dim: int) -> Policy:
-    return POLICIES.get(config.policy)(config, obs_dim, action_dim)
+def make_policy(config: TrainConfig, obs_dim: int, action_dim: int, subtasks: int = 0) -> Policy:
+    return POLICIES.get(config.policy)(config, obs_dim, action_dim, subtasks)
 
 
 def randn(shape: tuple[int, ...], generator: torch.Generator, like: torch.Tensor) -> torch.Tensor:
@@ -66,11 +118,11 @@ class DiffusionPolicy(Policy):
     """Diffusion Policy (Chi et al. 2023), state-based: a U-Net denoises the action chunk,
     conditioned on the flattened observation window; epsilon prediction; DDIM at inference."""
 
-    def __init__(self, config: TrainConfig, obs_dim: int, action_dim: int) -> None:
-        super().__init__(config, obs_dim, action_dim)
+    def __init__(self, config: TrainConfig, obs_dim: int, action_dim: int, subtasks: int = 0) -> None:
+        super().__init__(config, obs_dim, action_dim, subtasks)
         d = config.diffusion
-        self.unet = ConditionalUnet1D(action_dim, obs_dim * config.n_obs_steps, d.down_dims, d.kernel_size,
-                                      d.n_groups, d.step_embed_dim)
+        self.unet = ConditionalUnet1D(action_dim, self.cond_dim, d.down_dims, d.kernel_size, d.n_groups,
+                                      d.step_embed_dim)
         self.schedule = NoiseSchedule(d.train_timesteps, d.inference_steps, d.clip_sample)
 
     def draws(self, shape: torch.Size | tuple[int, ...], generator: torch.Generator,
@@ -80,19 +132,23 @@ class DiffusionPolicy(Policy):
         t = torch.randint(0, self.schedule.train_timesteps, (shape[0],), generator=generator)
         return noise, t.to(device)
 
-    def loss_from(self, obs: torch.Tensor, action: torch.Tensor, *draws: torch.Tensor) -> torch.Tensor:
+    def loss_from(self, obs: torch.Tensor, action: torch.Tensor, *draws: torch.Tensor,
+                  subtask: torch.Tensor | None = None) -> torch.Tensor:
         noise, t = draws
         noisy = self.schedule.add_noise(action, noise, t)
-        return F.mse_loss(self.unet(noisy, t, obs.flatten(1)), noise)
+        return F.mse_loss(self.unet(noisy, t, self.condition(obs, subtask)), noise) \
+            + self.subtask_loss(obs, subtask)
 
     @torch.no_grad()
-    def predict(self, obs: torch.Tensor, generator: torch.Generator) -> torch.Tensor:
+    def predict(self, obs: torch.Tensor, generator: torch.Generator,
+                subtask: torch.Tensor | None = None) -> torch.Tensor:
         return self.predict_from(obs, randn((obs.shape[0], self.config.horizon, self.action_dim), generator,
-                                            obs))
+                                            obs), subtask)
 
     @torch.no_grad()
-    def predict_from(self, obs: torch.Tensor, noise: torch.Tensor) -> torch.Tensor:
-        cond = obs.flatten(1)
+    def predict_from(self, obs: torch.Tensor, noise: torch.Tensor,
+                     subtask: torch.Tensor | None = None) -> torch.Tensor:
+        cond = self.condition(obs, subtask)
         return self.schedule.sample(lambda x_t, t: self.unet(x_t, t, cond), noise)
 
 
@@ -100,25 +156,28 @@ class DiffusionPolicy(Policy):
 class MlpPolicy(Policy):
     """Behaviour cloning: an MLP regresses the whole action chunk from the observation window."""
 
-    def __init__(self, config: TrainConfig, obs_dim: int, action_dim: int) -> None:
-        super().__init__(config, obs_dim, action_dim)
-        sizes = [obs_dim * config.n_obs_steps, *config.mlp.hidden]
+    def __init__(self, config: TrainConfig, obs_dim: int, action_dim: int, subtasks: int = 0) -> None:
+        super().__init__(config, obs_dim, action_dim, subtasks)
+        sizes = [self.cond_dim, *config.mlp.hidden]
         layers: list[nn.Module] = []
         for i, o in zip(sizes[:-1], sizes[1:], strict=True):
             layers += [nn.Linear(i, o), nn.ReLU()]
         layers.append(nn.Linear(sizes[-1], config.horizon * action_dim))
         self.net = nn.Sequential(*layers)
 
-    def forward(self, obs: torch.Tensor) -> torch.Tensor:
-        return self.net(obs.flatten(1)).view(obs.shape[0], self.config.horizon, self.action_dim)
+    def forward(self, obs: torch.Tensor, subtask: torch.Tensor | None = None) -> torch.Tensor:
+        return self.net(self.condition(obs, subtask)).view(obs.shape[0], self.config.horizon, self.action_dim)
 
-    def loss_from(self, obs: torch.Tensor, action: torch.Tensor, *draws: torch.Tensor) -> torch.Tensor:
-        return F.mse_loss(self(obs), action)
-
-    @torch.no_grad()
-    def predict(self, obs: torch.Tensor, generator: torch.Generator) -> torch.Tensor:
-        return self(obs)
+    def loss_from(self, obs: torch.Tensor, action: torch.Tensor, *draws: torch.Tensor,
+                  subtask: torch.Tensor | None = None) -> torch.Tensor:
+        return F.mse_loss(self(obs, subtask), action) + self.subtask_loss(obs, subtask)
 
     @torch.no_grad()
-    def predict_from(self, obs: torch.Tensor, noise: torch.Tensor) -> torch.Tensor:
-        return self(obs)
+    def predict(self, obs: torch.Tensor, generator: torch.Generator,
+                subtask: torch.Tensor | None = None) -> torch.Tensor:
+        return self(obs, subtask)
+
+    @torch.no_grad()
+    def predict_from(self, obs: torch.Tensor, noise: torch.Tensor,
+                     subtask: torch.Tensor | None = None) -> torch.Tensor:
+        return self(obs, subtask)

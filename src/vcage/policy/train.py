@@ -105,8 +105,11 @@ class Run:
         self.action_index = torch.from_numpy(windows.action)
         self.obs = torch.from_numpy(normalization["obs"].normalize(data.obs)).to(device)
         self.action = torch.from_numpy(normalization["action"].normalize(data.action)).to(device)
+        # each window's subtask is its current (last observed) frame's
+        self.subtask = None if data.subtask is None else torch.from_numpy(data.subtask).to(device)
         torch.manual_seed(config.seed)
-        self.model: Policy = make_policy(config, data.obs.shape[1], data.action.shape[1]).to(device)
+        self.model: Policy = make_policy(config, data.obs.shape[1], data.action.shape[1],
+                                         data.subtasks).to(device)
         self.ema = Ema(self.model, config.ema_power, config.ema_max_decay)
         self.optimizer = torch.optim.AdamW(self.model.parameters(), lr=config.lr,
                                            weight_decay=config.weight_decay, capturable=graph)
@@ -116,9 +119,17 @@ class Run:
         self.losses: list[float] = []
         self.graphed = GraphedStep(self) if graph else None  # captured at its first steps, after restore
 
-    def batch(self) -> tuple[torch.Tensor, torch.Tensor]:
+    def batch(self) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor | None]:
+        """The next batch's observation windows, action chunks and (if conditioned) subtasks."""
         rows = torch.from_numpy(self.sampler.next_batch())
-        return self.obs[self.obs_index[rows]], self.action[self.action_index[rows]]
+        return self.gather(rows, self.obs_index, self.action_index)
+
+    def gather(self, rows: torch.Tensor, obs_index: torch.Tensor,
+               action_index: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor | None]:
+        """The windows of ``rows``: observations, actions and the subtask of each one's current frame."""
+        frames = obs_index[rows]
+        subtask = None if self.subtask is None else self.subtask[frames[:, -1]]
+        return self.obs[frames], self.action[action_index[rows]], subtask
 
     def train_step(self) -> float:
         """One optimiser step; TrainingDivergedError (before any weight changes, except in a CUDA
@@ -135,8 +146,8 @@ class Run:
             return value
         for group in self.optimizer.param_groups:
             group["lr"] = learning_rate(self.config, self.step)
-        obs, action = self.batch()
-        loss = self.model.loss(obs, action, self.generator)
+        obs, action, subtask = self.batch()
+        loss = self.model.loss(obs, action, self.generator, subtask)
         value = float(loss.item())
         if not math.isfinite(value):
             raise TrainingDivergedError(f"the loss became {value} at step {self.step + 1}")
@@ -156,7 +167,7 @@ class Run:
             "vcage_version": __version__, "torch_version": str(torch.__version__),
             "config": self.config.to_dict(), "dataset": self.data.info.to_dict(),
             "obs_features": [f.to_dict() for f in self.data.obs_features],
-            "action_feature": self.data.action_feature.to_dict(),
+            "action_feature": self.data.action_feature.to_dict(), "subtasks": self.data.subtasks,
             "normalization": {k: v.to_dict() for k, v in self.normalization.items()},
             "step": self.step, "loss_history": torch.tensor(self.losses, dtype=torch.float64),
             "model": self.model.state_dict(), "ema": self.ema.state_dict(),
