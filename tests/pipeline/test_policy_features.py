@@ -111,6 +111,41 @@ def test_replaying_an_episode_in_the_evaluation_env_gives_its_frames_and_success
         env.step(ep.frames["action"][-1])
 
 
+def test_an_episode_started_at_a_later_subtask_continues_the_demonstration_from_there(made: Path) -> None:
+    reader = DatasetReader(made)
+    ep = reader.episode(0)
+    start = ep.extras["subtasks"][1]["frames"][0]
+    env = make_env(reader.config, seed=0)
+    obs, info = env.reset(options={"scene_seed": ep.extras["seed"], "state": ep.arrays["states"][start],
+                                   "subtask": 1})
+    assert info["subtasks_done"] == 1 and not info["success"]
+    assert env.unwrapped.holds(0)  # the mouse lies on its pad
+    for key in OBSERVED:
+        np.testing.assert_allclose(obs[key], ep.frames[key][start], atol=1e-5, err_msg=key)
+    for t in range(start, ep.length):  # the rest of the demonstration completes the plan
+        obs, reward, terminated, truncated, info = env.step(ep.frames["action"][t])
+        if terminated:
+            break
+    assert info["success"] and reward == 1.0
+    # from the same state judged from subtask 0, holding still completes nothing: the mouse's
+    # subtask is judged again (it holds: the mouse lies on its pad) and the bell's is not done
+    env.reset(options={"scene_seed": ep.extras["seed"]})
+    assert not env.unwrapped.holds(0)  # at the scene's start the mouse lies elsewhere
+    env.reset(options={"scene_seed": ep.extras["seed"], "state": ep.arrays["states"][start]})
+    for _ in range(12):
+        obs, _, terminated, _, info = env.step(np.append(obs["observation.state"][:7], 1.0))
+    assert info["subtasks_done"] == 1 and not terminated
+    with pytest.raises(ConfigError, match="options\\['state'\\] too"):
+        env.reset(options={"subtask": 1})
+    with pytest.raises(ConfigError, match="scene_seed"):
+        env.reset(options={"state": ep.arrays["states"][start]})
+    state = ep.arrays["states"][start]
+    with pytest.raises(ConfigError, match="from 0 to 1"):
+        env.reset(options={"scene_seed": ep.extras["seed"], "state": state, "subtask": 2})
+    with pytest.raises(ConfigError, match="finite numbers"):
+        env.reset(options={"scene_seed": ep.extras["seed"], "state": state[:-3]})
+
+
 def test_evaluation_scenes_are_never_training_scenes_and_repeat_by_seed(made: Path) -> None:
     reader = DatasetReader(made)
     env = make_env(reader.config, seed=3, max_steps=4)

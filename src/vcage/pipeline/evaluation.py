@@ -10,7 +10,10 @@ randomisation) and simulator settings as the generation run that made the datase
   Generation's attempt seeds are below ``2**32`` (:meth:`GenerateConfig.episode_seed`), so no
   evaluation scene is a training scene, for any dataset. ``reset(options={"scene_seed": seed})``
   builds the scene of a given seed instead (an audit: a training episode's seed gives its scene,
-  and replaying its actions reproduces its frames).
+  and replaying its actions reproduces its frames). With it, ``"state"`` (a simulator state a
+  dataset stores, ``states`` of its episode arrays) and ``"subtask"`` start the episode from that
+  state, judged from that subtask on (the earlier ones counted done): can a policy do the second
+  subtask of a plan when it is put where a demonstration began it?
 * **Observations** are the dataset's feature vectors (:mod:`vcage.pipeline.features`):
   ``observation.state``, ``observation.ee_pose``, ``observation.environment_state``, read as the
   recording reads them during generation.
@@ -64,6 +67,7 @@ from vcage.skills.reachability import reach_map
 from vcage.synthesis.errors import SynthesisError
 from vcage.tasks.oracle import Oracle
 from vcage.tasks.success import HOLD_STEPS
+from vcage.vocabulary import PREDICATES, Kind
 
 EVAL_SEED_BASE = 2**32  # generation's attempt seeds are below: evaluation scenes are never training scenes
 STEPS_PER_SUBTASK = 600  # default episode length: 30 s per subtask at 20 Hz (experts take 5-15 s)
@@ -204,18 +208,40 @@ class GoalEnv(gym.Env[dict[str, np.ndarray], np.ndarray]):
             if isinstance(episode, bool) or not isinstance(episode, int | np.integer) or episode < 0:
                 raise ConfigError(f"options['episode'] must be an episode index >= 0, got {episode!r}")
             self._episode = int(episode)
+        subtask = self._start_subtask(options)
         if options.get("scene_seed") is not None:  # an audit: e.g. a training episode's scene
             scene_seed = int(options["scene_seed"])
             world = self._scene(scene_seed)
         else:
+            if options.get("state") is not None:
+                raise ConfigError("options['state'] is a state of a given scene: pass its "
+                                  "options['scene_seed'] too")
             world, scene_seed = self._episode_scene(self._base, self._episode)
             self._episode += 1
+        if options.get("state") is not None:
+            state = np.asarray(options["state"], dtype=float).reshape(-1)
+            size = world.get_state().size
+            if state.size != size or not np.isfinite(state).all():
+                raise ConfigError(f"options['state'] must be {size} finite numbers (a state the dataset of "
+                                  f"this scene stores), got {state.size}")
+            world.set_state(state)
         self._close_renderer()
         self.world, self.scene_seed = world, scene_seed
-        self._done = self._streak = self._steps = 0
+        self._done, self._streak, self._steps = subtask, 0, 0
         self._arm_target = world.robot.arm_q(world.data)
-        self._oracle.begin(self.plan.subtasks[0].predicates)
+        self._oracle.begin(self.plan.subtasks[subtask].predicates)
         return observe(world, self.plan), self._info()
+
+    def _start_subtask(self, options: dict[str, Any]) -> int:
+        subtask = options.get("subtask", 0)
+        n = len(self.plan.subtasks)
+        if isinstance(subtask, bool) or not isinstance(subtask, int | np.integer) or not 0 <= subtask < n:
+            raise ConfigError(f"options['subtask'] must be a subtask index from 0 to {n - 1}, "
+                              f"got {subtask!r}")
+        if subtask and options.get("state") is None:
+            raise ConfigError("options['subtask'] starts an episode from a later subtask, which needs the "
+                              "state a demonstration reached there: pass options['state'] too")
+        return int(subtask)
 
     def step(self, action: np.ndarray) -> tuple[dict[str, np.ndarray], float, bool, bool, dict[str, Any]]:
         world = self.world
@@ -256,6 +282,14 @@ class GoalEnv(gym.Env[dict[str, np.ndarray], np.ndarray]):
         assert self._arm_target is not None
         self._arm_target = self._ik.track(action[:3], quat_to_mat(action[3:7]), self._arm_target)
         return self._arm_target
+
+    def holds(self, subtask: int) -> bool:
+        """Whether the goal of ``subtask`` holds now: its predicates that are states (an event, such
+        as a press, is over once it happened); e.g. is an earlier subtask's work still in place?"""
+        if self.world is None:
+            raise ResetNeeded("call reset() first")
+        return all(self._oracle.value(self.world, p) for p in self.plan.subtasks[subtask].predicates
+                   if PREDICATES.get(p.name).kind is not Kind.EVENT)
 
     def _info(self) -> dict[str, Any]:
         n = len(self.plan.subtasks)

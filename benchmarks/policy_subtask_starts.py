@@ -1,0 +1,79 @@
+"""Can a policy do a plan's later subtask when it is put where a demonstration began it?
+
+For the first ``--episodes`` episodes of the dataset a checkpoint was trained on, the evaluation
+environment builds the episode's scene, sets the simulator state the demonstration had at the first
+frame of subtask ``--subtask`` (earlier subtasks counted done) and rolls the policy out from there.
+It prints how many episodes complete the plan, and in how many the earlier subtasks' work is no
+longer in place at the end (the policy went back to it: a mouse picked off its pad again). A
+subtask-conditioned policy also reports the subtask its classifier named at the first chunk.
+
+    LP_NUM_THREADS=1 .venv/bin/python benchmarks/policy_subtask_starts.py RUN --subtask 1 --episodes 20
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("checkpoint", type=Path, help="a checkpoint file or a training run's directory")
+    parser.add_argument("--dataset", type=Path, default=None,
+                        help="the dataset whose demonstrations give the starts (default: the checkpoint's)")
+    parser.add_argument("--subtask", type=int, default=1, help="the subtask to start at (0-based)")
+    parser.add_argument("--episodes", type=int, default=20, help="demonstrations to start from")
+    parser.add_argument("--max-steps", type=int, default=600, help="control steps per episode at most")
+    parser.add_argument("--seed", type=int, default=0, help="seed of the sampler's noise")
+    args = parser.parse_args()
+
+    import numpy as np
+    import torch
+
+    from vcage.data.reader import DatasetReader
+    from vcage.pipeline.evaluation import make_env
+    from vcage.policy.checkpoint import load_checkpoint
+    from vcage.policy.evaluate import episode_noise_seed
+    from vcage.policy.inference import PolicyRunner
+
+    torch.set_num_threads(1)
+    payload = load_checkpoint(args.checkpoint)
+    reader = DatasetReader(args.dataset or payload["dataset"]["path"], videos=False)
+    env = make_env(payload["dataset"]["config"], seed=args.seed, max_steps=args.max_steps,
+                   action=payload["action_feature"]["name"])
+    goal = env.unwrapped
+    if not 0 < args.subtask < len(goal.plan.subtasks):
+        parser.error(f"--subtask must be a later subtask of the plan: 1 to {len(goal.plan.subtasks) - 1}")
+    runner = PolicyRunner(payload, seed=args.seed)
+    done = undone = named_right = 0
+    episodes = min(args.episodes, reader.num_episodes)
+    steps = []
+    for k in range(episodes):
+        extras = reader.extras(k)
+        start = extras["subtasks"][args.subtask]["frames"][0]
+        runner.reset(episode_noise_seed(args.seed, k))
+        obs, info = env.reset(options={"scene_seed": extras["seed"], "subtask": args.subtask,
+                                       "state": reader.arrays(k)["states"][start]})
+        first, t, terminated, truncated = None, 0, False, False
+        while not (terminated or truncated):
+            obs, _, terminated, truncated, info = env.step(runner.act(obs))
+            first = runner.subtask if first is None else first
+            t += 1
+        back = not all(goal.holds(j) for j in range(args.subtask))
+        done += bool(info["success"])
+        undone += back
+        named_right += first == args.subtask
+        steps.append(t)
+        print(f"  episode {k}: {'completed' if info['success'] else 'not completed'} in {t} steps"
+              f"{'; earlier work undone' if back else ''}"
+              f"{f'; classifier named subtask {first} first' if runner.model.subtasks else ''}", flush=True)
+    print(f"{payload['path']}")
+    print(f"started at subtask {args.subtask} of {len(goal.plan.subtasks)} from {episodes} demonstrations of "
+          f"{reader.root} (their own training scenes): completed {done}/{episodes}, earlier work undone in "
+          f"{undone}/{episodes}, median {int(np.median(steps))} steps"
+          + (f"; classifier named subtask {args.subtask} at the first chunk in {named_right}/{episodes}"
+             if runner.model.subtasks else ""))
+
+
+if __name__ == "__main__":
+    main()
