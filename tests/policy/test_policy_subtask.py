@@ -190,3 +190,21 @@ def test_the_cli_refuses_subtask_conditioning_on_a_dataset_without_subtasks(tmp_
     assert result.exit_code != 0
     assert "subtask_index" in result.output and "vcage backfill" in result.output
     assert not (tmp_path / "run" / "checkpoints").exists()
+
+
+def test_evaluation_refuses_a_plan_with_another_number_of_subtasks(plan_dataset: Path, generated: Path,
+                                                                    tmp_path: Path) -> None:
+    from vcage.data.reader import DatasetReader
+    from vcage.pipeline.evaluation import make_env
+    from vcage.policy.errors import EnvironmentMismatchError
+    from vcage.policy.evaluate import check_compatible
+
+    config = tiny("mlp", subtask_conditioned=True, steps=2, checkpoint_every=2)
+    payload = load_checkpoint(train(plan_dataset, tmp_path / "run", config).checkpoint)
+    env = make_env(DatasetReader(generated).config, seed=0, max_steps=2)  # "press the bell": one subtask
+    with pytest.raises(EnvironmentMismatchError, match="on 2 subtasks, the environment's plan has 1"):
+        check_compatible(payload, env)
+    payload["subtasks"] = 0
+    with pytest.raises(EnvironmentMismatchError) as caught:
+        check_compatible(payload, env)
+    assert "subtasks" not in str(caught.value)

@@ -125,6 +125,10 @@ def check_compatible(checkpoint: Mapping[str, Any], env: gym.Env) -> None:
     name, env_name = checkpoint["action_feature"]["name"], getattr(env.unwrapped, "action_key", ACTION)
     if name != env_name:
         problems.append(f"the environment takes {env_name!r} as its action, the checkpoint predicts {name!r}")
+    subtasks, plan = int(checkpoint.get("subtasks", 0)), getattr(env.unwrapped, "plan", None)
+    if subtasks and plan is not None and len(plan.subtasks) != subtasks:
+        problems.append(f"the policy is conditioned on {subtasks} subtasks, the environment's plan has "
+                        f"{len(plan.subtasks)}")
     fps, env_fps = int(checkpoint["dataset"]["fps"]), env.metadata.get("render_fps")
     if env_fps is not None and int(env_fps) != fps:
         problems.append(f"the environment steps at {env_fps} Hz, the dataset was recorded at {fps} fps")

@@ -29,6 +29,14 @@ from vcage.registry import Registry
 SUBTASK_HIDDEN = (256, 256)  # the subtask classifier's hidden layers
 
 
+def mlp(sizes: list[int]) -> nn.Sequential:
+    """Linear layers of the given sizes (input first, output last) with ReLU between them."""
+    layers: list[nn.Module] = []
+    for i, o in zip(sizes[:-2], sizes[1:-1], strict=True):
+        layers += [nn.Linear(i, o), nn.ReLU()]
+    return nn.Sequential(*layers, nn.Linear(sizes[-2], sizes[-1]))
+
+
 class Policy(nn.Module):
     """Observation window -> action chunk, both normalised; with ``subtasks`` > 0, also conditioned
     on the plan's subtask, which :meth:`classify` names from the window."""
@@ -36,13 +44,8 @@ class Policy(nn.Module):
     def __init__(self, config: TrainConfig, obs_dim: int, action_dim: int, subtasks: int = 0) -> None:
         super().__init__()
         self.config, self.obs_dim, self.action_dim, self.subtasks = config, obs_dim, action_dim, subtasks
-        self.subtask_head: nn.Module | None = None
-        if subtasks:
-            sizes = [obs_dim * config.n_obs_steps, *SUBTASK_HIDDEN]
-            layers: list[nn.Module] = []
-            for i, o in zip(sizes[:-1], sizes[1:], strict=True):
-                layers += [nn.Linear(i, o), nn.ReLU()]
-            self.subtask_head = nn.Sequential(*layers, nn.Linear(sizes[-1], subtasks))
+        self.subtask_head = mlp([obs_dim * config.n_obs_steps, *SUBTASK_HIDDEN, subtasks]) \
+            if subtasks else None
 
     @property
     def cond_dim(self) -> int:
@@ -158,12 +161,7 @@ class MlpPolicy(Policy):
 
     def __init__(self, config: TrainConfig, obs_dim: int, action_dim: int, subtasks: int = 0) -> None:
         super().__init__(config, obs_dim, action_dim, subtasks)
-        sizes = [self.cond_dim, *config.mlp.hidden]
-        layers: list[nn.Module] = []
-        for i, o in zip(sizes[:-1], sizes[1:], strict=True):
-            layers += [nn.Linear(i, o), nn.ReLU()]
-        layers.append(nn.Linear(sizes[-1], config.horizon * action_dim))
-        self.net = nn.Sequential(*layers)
+        self.net = mlp([self.cond_dim, *config.mlp.hidden, config.horizon * action_dim])
 
     def forward(self, obs: torch.Tensor, subtask: torch.Tensor | None = None) -> torch.Tensor:
         return self.net(self.condition(obs, subtask)).view(obs.shape[0], self.config.horizon, self.action_dim)
