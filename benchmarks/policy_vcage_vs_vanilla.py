@@ -137,7 +137,7 @@ def train_config(args: argparse.Namespace, train_seed: int) -> Any:
     return TrainConfig(policy=args.policy, steps=steps, lr=args.lr, seed=train_seed,
                        batch_size=args.batch_size, diffusion=diffusion, action_key=args.action,
                        observation_keys=tuple(args.obs) if args.obs else None,
-                       subtask_conditioned=args.subtask_conditioned,
+                       subtask_conditioned=args.subtask_conditioned, n_obs_steps=args.n_obs_steps,
                        checkpoint_every=max(1, min(args.checkpoint_every, steps)))
 
 
@@ -407,6 +407,7 @@ def main() -> None:
     parser.add_argument("--subtask-conditioned", action="store_true",
                         help="condition the policies on the plan's subtask, named by a classifier head at "
                         "evaluation (hierarchical; goals only need it)")
+    parser.add_argument("--n-obs-steps", type=int, default=2, help="observation frames the policies read")
     parser.add_argument("--steps", type=int, default=15000, help="training steps per checkpoint run")
     parser.add_argument("--lr", type=float, default=1e-3, help="peak learning rate")
     parser.add_argument("--batch-size", type=int, default=64)

@@ -31,6 +31,9 @@ def train_cmd(
         action: str = typer.Option(None, help="what the policy predicts: action (default: the 7 joint "
                                    "targets and the gripper) or action.ee_pose (the tool's target pose "
                                    "and the gripper; evaluation turns it into joint targets by IK)"),
+        n_obs_steps: int = typer.Option(None, min=1, help="observation frames the policy reads, the "
+                                        "current one and those before it (default 2); the actions executed "
+                                        "from the current frame on must fit in the 16-step chunk"),
         rotations: str = typer.Option(None, help="how the policy reads quaternions: rot6d (default: "
                                       "rotation-matrix columns, continuous) or quaternion (as stored)"),
         keep_checkpoints: int = typer.Option(None, min=1, help="keep only this many newest checkpoints "
@@ -59,6 +62,7 @@ def train_cmd(
     given: dict[str, Any] = {"policy": policy, "steps": steps, "batch_size": batch_size, "lr": lr,
                              "seed": seed, "checkpoint_every": checkpoint_every, "rotations": rotations,
                              "action_key": action, "subtask_conditioned": subtask_conditioned,
+                             "n_obs_steps": n_obs_steps,
                              "observation_keys": split_keys(obs) if obs else None}
     given = {k: v for k, v in given.items() if v is not None}
     base = stored_config(out) if resume else None
