@@ -3,9 +3,10 @@
 For the first ``--episodes`` episodes of the dataset a checkpoint was trained on, the evaluation
 environment builds the episode's scene, sets the simulator state the demonstration had at the first
 frame of subtask ``--subtask`` (earlier subtasks counted done) and rolls the policy out from there.
-It prints how many episodes complete the plan, and in how many the earlier subtasks' work is no
-longer in place at the end (the policy went back to it: a mouse picked off its pad again). A
-subtask-conditioned policy also reports the subtask its classifier named at the first chunk.
+It prints how many episodes complete that subtask and how many the whole plan, and in how many the
+earlier subtasks' work is no longer in place at the end (the policy went back to it: a mouse
+picked off its pad again). A subtask-conditioned policy also reports the subtask its classifier
+named at the first chunk.
 
     LP_NUM_THREADS=1 .venv/bin/python benchmarks/policy_subtask_starts.py RUN --subtask 1 --episodes 20
 """
@@ -45,7 +46,7 @@ def main() -> None:
     if not 0 < args.subtask < len(goal.plan.subtasks):
         parser.error(f"--subtask must be a later subtask of the plan: 1 to {len(goal.plan.subtasks) - 1}")
     runner = PolicyRunner(payload, seed=args.seed)
-    done = undone = named_right = 0
+    done = undone = named_right = started_done = 0
     episodes = min(args.episodes, reader.num_episodes)
     steps = []
     for k in range(episodes):
@@ -61,6 +62,7 @@ def main() -> None:
             t += 1
         back = not all(goal.holds(j) for j in range(args.subtask))
         done += bool(info["success"])
+        started_done += info["subtasks_done"] > args.subtask
         undone += back
         named_right += first == args.subtask
         steps.append(t)
@@ -69,7 +71,8 @@ def main() -> None:
               f"{f'; classifier named subtask {first} first' if runner.model.subtasks else ''}", flush=True)
     print(f"{payload['path']}")
     print(f"started at subtask {args.subtask} of {len(goal.plan.subtasks)} from {episodes} demonstrations of "
-          f"{reader.root} (their own training scenes): completed {done}/{episodes}, earlier work undone in "
+          f"{reader.root} (their own training scenes): subtask {args.subtask} done in "
+          f"{started_done}/{episodes}, plan completed in {done}/{episodes}, earlier work undone in "
           f"{undone}/{episodes}, median {int(np.median(steps))} steps"
           + (f"; classifier named subtask {args.subtask} at the first chunk in {named_right}/{episodes}"
              if runner.model.subtasks else ""))
