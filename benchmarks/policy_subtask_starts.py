@@ -34,14 +34,16 @@ def main() -> None:
     from vcage.data.reader import DatasetReader
     from vcage.pipeline.evaluation import make_env
     from vcage.policy.checkpoint import load_checkpoint
-    from vcage.policy.evaluate import episode_noise_seed
+    from vcage.policy.evaluate import check_compatible, episode_noise_seed
     from vcage.policy.inference import PolicyRunner
 
     torch.set_num_threads(1)
     payload = load_checkpoint(args.checkpoint)
     reader = DatasetReader(args.dataset or payload["dataset"]["path"], videos=False)
-    env = make_env(payload["dataset"]["config"], seed=args.seed, max_steps=args.max_steps,
+    # the environment of the dataset that gives the starts: its scene seeds build its own scenes
+    env = make_env(reader.config, seed=args.seed, max_steps=args.max_steps,
                    action=payload["action_feature"]["name"])
+    check_compatible(payload, env)
     goal = env.unwrapped
     if not 0 < args.subtask < len(goal.plan.subtasks):
         parser.error(f"--subtask must be a later subtask of the plan: 1 to {len(goal.plan.subtasks) - 1}")
