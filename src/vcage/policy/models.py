@@ -37,6 +37,13 @@ def mlp(sizes: list[int]) -> nn.Sequential:
     return nn.Sequential(*layers, nn.Linear(sizes[-2], sizes[-1]))
 
 
+def given(subtask: torch.Tensor | None) -> torch.Tensor:
+    """The batch's subtasks, which a subtask-conditioned policy cannot do without."""
+    if subtask is None:
+        raise ValueError("a subtask-conditioned policy needs the subtask of every sample")
+    return subtask
+
+
 class Policy(nn.Module):
     """Observation window -> action chunk, both normalised; with ``subtasks`` > 0, also conditioned
     on the plan's subtask, which :meth:`classify` names from the window."""
@@ -57,9 +64,7 @@ class Policy(nn.Module):
         flat = obs.flatten(1)
         if not self.subtasks:
             return flat
-        if subtask is None:
-            raise ValueError("a subtask-conditioned policy needs the subtask of every sample")
-        return torch.cat([flat, F.one_hot(subtask, self.subtasks).to(flat.dtype)], dim=1)
+        return torch.cat([flat, F.one_hot(given(subtask), self.subtasks).to(flat.dtype)], dim=1)
 
     def classify(self, obs: torch.Tensor) -> torch.Tensor:
         """Logits (B, subtasks) of the subtask each observation window is in."""
@@ -71,9 +76,7 @@ class Policy(nn.Module):
         """The classifier's cross-entropy on the batch's subtasks (0 without a classifier)."""
         if self.subtask_head is None:
             return 0.0
-        if subtask is None:
-            raise ValueError("a subtask-conditioned policy needs the subtask of every sample")
-        return F.cross_entropy(self.classify(obs), subtask)
+        return F.cross_entropy(self.classify(obs), given(subtask))
 
     def loss(self, obs: torch.Tensor, action: torch.Tensor, generator: torch.Generator,
              subtask: torch.Tensor | None = None) -> torch.Tensor:
