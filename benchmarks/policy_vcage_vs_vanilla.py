@@ -138,6 +138,7 @@ def train_config(args: argparse.Namespace, train_seed: int) -> Any:
                        batch_size=args.batch_size, diffusion=diffusion, action_key=args.action,
                        observation_keys=tuple(args.obs) if args.obs else None,
                        subtask_conditioned=args.subtask_conditioned, n_obs_steps=args.n_obs_steps,
+                       obs_stride=args.obs_stride,
                        checkpoint_every=max(1, min(args.checkpoint_every, steps)))
 
 
@@ -408,6 +409,7 @@ def main() -> None:
                         help="condition the policies on the plan's subtask, named by a classifier head at "
                         "evaluation (hierarchical; goals only need it)")
     parser.add_argument("--n-obs-steps", type=int, default=2, help="observation frames the policies read")
+    parser.add_argument("--obs-stride", type=int, default=1, help="frames between two observed frames")
     parser.add_argument("--steps", type=int, default=15000, help="training steps per checkpoint run")
     parser.add_argument("--lr", type=float, default=1e-3, help="peak learning rate")
     parser.add_argument("--batch-size", type=int, default=64)

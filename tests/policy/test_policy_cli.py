@@ -54,19 +54,21 @@ def test_train_then_evaluate_in_the_datasets_environment(generated: Path, tmp_pa
 def test_sizes_are_set_from_the_cli_and_an_exported_copy_evaluates(generated: Path, tmp_path: Path) -> None:
     out, moved = tmp_path / "run", tmp_path / "moved.pt"
     result = RUN.invoke(app, ["train", str(generated), "--out", str(out), "--steps", "2", "--batch-size", "4",
-                              "--down-dims", "16,32", "--n-obs-steps", "4", "--threads", "1",
-                              "--export", str(moved)])
+                              "--down-dims", "16,32", "--n-obs-steps", "4", "--obs-stride", "3",
+                              "--threads", "1", "--export", str(moved)])
     assert result.exit_code == 0, result.output
     assert "exported for evaluation" in flat(result.output)
     copy = load_checkpoint(moved)
     assert tuple(copy["config"]["diffusion"]["down_dims"]) == (16, 32) and copy["evaluation_only"] is True
-    assert copy["config"]["n_obs_steps"] == 4
+    assert copy["config"]["n_obs_steps"] == 4 and copy["config"]["obs_stride"] == 3
     evaluated = RUN.invoke(app, ["evaluate", str(moved), "--episodes", "1", "--max-steps", "8"])
     assert evaluated.exit_code == 0, evaluated.output
     bad = RUN.invoke(app, ["train", str(generated), "--out", str(tmp_path / "other"), "--down-dims", "16,x"])
     assert bad.exit_code == 2 and "comma-separated integers" in flat(bad.output)
     long = RUN.invoke(app, ["train", str(generated), "--out", str(tmp_path / "other"), "--n-obs-steps", "10"])
     assert long.exit_code == 2 and "must fit in the horizon 16" in flat(long.output)
+    still = RUN.invoke(app, ["train", str(generated), "--out", str(tmp_path / "other"), "--obs-stride", "0"])
+    assert still.exit_code == 2 and "--obs-stride" in flat(still.output)
     assert not (tmp_path / "other").exists()
 
 

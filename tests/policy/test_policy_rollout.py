@@ -89,6 +89,32 @@ def test_the_runner_predicts_every_eight_steps_from_a_two_frame_window(checkpoin
     assert len(seen) == 4 and torch.equal(seen[3][0][0], seen[3][0][1])
 
 
+def test_a_strided_runner_reads_every_kth_observation_back_from_the_current_one(dataset: Path,
+                                                                                tmp_path: Path) -> None:
+    config = tiny("mlp", steps=1, checkpoint_every=1, n_obs_steps=3, obs_stride=4, horizon=16)
+    runner = PolicyRunner(load_checkpoint(train(dataset, tmp_path / "run", config).checkpoint))
+    seen: list[torch.Tensor] = []
+
+    def predict_from(obs: torch.Tensor, noise: torch.Tensor, subtask: torch.Tensor | None) -> torch.Tensor:
+        seen.append(obs.clone())
+        return torch.zeros(1, 16, 8)
+
+    runner.model.predict_from = predict_from  # type: ignore[method-assign]
+    env = CountingEnv(set(), max_steps=30)
+    obs, _ = env.reset()
+    for _ in range(17):  # chunks at steps 0, 8 and 16, whose observations count 0, 8 and 16
+        obs, *_ = env.step(runner.act(obs))
+    assert len(seen) == 3 and seen[0].shape == (1, 3, 26)
+    norm, encode = runner.obs_norm, runner.encoder
+
+    def frames(*counts: float) -> torch.Tensor:
+        return torch.from_numpy(np.stack([norm.normalize(encode(np.full(22, c))) for c in counts]))
+
+    torch.testing.assert_close(seen[0][0], frames(0, 0, 0))
+    torch.testing.assert_close(seen[1][0], frames(0, 4, 8))  # the start repeated before frame 0
+    torch.testing.assert_close(seen[2][0], frames(8, 12, 16))
+
+
 def test_evaluate_rolls_out_every_episode_and_counts_what_the_environment_reports(checkpoint: Path) -> None:
     envs: list[CountingEnv] = []
 

@@ -23,6 +23,15 @@ def test_windows_pad_by_repeating_the_first_and_last_frame_of_their_own_episode(
     assert w.action[-1].tolist() == [6, 7, 7, 7]
 
 
+def test_a_strided_window_observes_every_kth_frame_back_and_keeps_the_action_chunk() -> None:
+    w = make_windows([10], n_obs=3, horizon=4, stride=4)
+    assert w.obs[9].tolist() == [1, 5, 9] and w.obs[5].tolist() == [0, 1, 5]  # clipped at the first frame
+    assert w.obs[0].tolist() == [0, 0, 0]
+    plain = make_windows([10], n_obs=3, horizon=4)
+    # the chunk still starts n_obs - 1 frames back, so the executed actions start at the current frame
+    assert np.array_equal(w.action, plain.action) and w.action[9].tolist() == [7, 8, 9, 9]
+
+
 def test_every_window_stays_in_its_episode(dataset: Path) -> None:
     data = load_training_data(dataset, tiny("mlp"))
     w = make_windows(data.lengths, 2, 16)

@@ -34,6 +34,8 @@ def train_cmd(
         n_obs_steps: int = typer.Option(None, min=1, help="observation frames the policy reads, the "
                                         "current one and those before it (default 2); the actions executed "
                                         "from the current frame on must fit in the 16-step chunk"),
+        obs_stride: int = typer.Option(None, min=1, help="frames between two observed frames (default 1): "
+                                       "with --n-obs-steps 8 --obs-stride 4 the policy sees 1.45 s back"),
         rotations: str = typer.Option(None, help="how the policy reads quaternions: rot6d (default: "
                                       "rotation-matrix columns, continuous) or quaternion (as stored)"),
         keep_checkpoints: int = typer.Option(None, min=1, help="keep only this many newest checkpoints "
@@ -62,7 +64,7 @@ def train_cmd(
     given: dict[str, Any] = {"policy": policy, "steps": steps, "batch_size": batch_size, "lr": lr,
                              "seed": seed, "checkpoint_every": checkpoint_every, "rotations": rotations,
                              "action_key": action, "subtask_conditioned": subtask_conditioned,
-                             "n_obs_steps": n_obs_steps,
+                             "n_obs_steps": n_obs_steps, "obs_stride": obs_stride,
                              "observation_keys": split_keys(obs) if obs else None}
     given = {k: v for k, v in given.items() if v is not None}
     base = stored_config(out) if resume else None

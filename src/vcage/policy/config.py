@@ -125,6 +125,10 @@ class TrainConfig:
     obs_norm: str = "min_max"  # observations to [-1, 1] (min_max) or to zero mean, unit std (mean_std)
     rotations: str = "rot6d"  # quaternions read as rotation-matrix columns (see vcage.policy.encoding)
     n_obs_steps: int = 2
+    # frames between two observed frames: the window reaches (n_obs_steps - 1) * obs_stride frames back,
+    # so a few frames can span a whole motion (the way down to a button and the way back up look
+    # alike over 2 frames; docs/BENCHMARKS.md)
+    obs_stride: int = 1
     horizon: int = 16
     n_action_steps: int = 8
     ema_power: float = 0.75  # EMA decay 1 - (1 + step) ** -power, at most ema_max_decay
@@ -145,7 +149,8 @@ class TrainConfig:
             raise ConfigError(f"unknown action {self.action_key!r}; valid: {', '.join(ACTIONS)}")
         if self.rotations not in ROTATIONS:
             raise ConfigError(f"unknown rotations {self.rotations!r}; valid: {', '.join(ROTATIONS)}")
-        for name in ("steps", "batch_size", "checkpoint_every", "n_obs_steps", "horizon", "n_action_steps"):
+        for name in ("steps", "batch_size", "checkpoint_every", "n_obs_steps", "obs_stride", "horizon",
+                     "n_action_steps"):
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, int) or value < 1:
                 raise ConfigError(f"{name} must be a positive integer, got {value!r}")

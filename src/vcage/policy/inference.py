@@ -1,7 +1,8 @@
 """A trained policy acting in an environment: observation window in, one action out per step.
 
-The runner keeps the last ``n_obs_steps`` observations (the first one repeated after a reset, as
-training pads the start of an episode) and a queue of actions: when the queue is empty it predicts
+The runner keeps the last ``(n_obs_steps - 1) * obs_stride + 1`` observations (the first one
+repeated after a reset, as training pads the start of an episode), of which the policy reads every
+``obs_stride``-th back from the current one, and a queue of actions: when the queue is empty it predicts
 a chunk of ``horizon`` actions from the window and queues the ``n_action_steps`` starting at the
 current frame (index ``n_obs_steps - 1`` of the chunk), as Diffusion Policy executes them.
 
@@ -51,7 +52,8 @@ class PolicyRunner:
                               "damaged: train again") from None
         self.model.to(self.device).eval()
         self.generator = torch.Generator().manual_seed(seed)
-        self._window: deque[np.ndarray] = deque(maxlen=self.config.n_obs_steps)
+        self.span = (self.config.n_obs_steps - 1) * self.config.obs_stride + 1  # frames the window reaches
+        self._window: deque[np.ndarray] = deque(maxlen=self.span)
         self._queue: deque[np.ndarray] = deque()
         self.subtask = 0  # the subtask a subtask-conditioned policy is in (always 0 for others)
 
@@ -80,9 +82,13 @@ class PolicyRunner:
     def _observe(self, obs: Mapping[str, Any]) -> None:
         vector = self.obs_norm.normalize(self.observation_vector(obs))
         if not self._window:
-            self._window.extend([vector] * self.config.n_obs_steps)
+            self._window.extend([vector] * self.span)
         else:
             self._window.append(vector)
+
+    def window(self) -> np.ndarray:
+        """The observation window the policy reads now (n_obs_steps, size), oldest frame first."""
+        return np.stack(list(self._window)[::self.config.obs_stride])
 
     def _queue_chunk(self, chunk: np.ndarray) -> None:
         start = self.config.n_obs_steps - 1
@@ -103,7 +109,7 @@ def act_together(runners: Sequence[PolicyRunner],
     due = [r for r in runners if not r._queue]
     if due:
         lead = runners[0]
-        windows = torch.from_numpy(np.stack([np.stack(r._window) for r in due])).to(lead.device)
+        windows = torch.from_numpy(np.stack([r.window() for r in due])).to(lead.device)
         shape = (1, lead.config.horizon, lead.action_encoder.size)
         noise = torch.cat([randn(shape, r.generator, windows) for r in due])
         subtask = None

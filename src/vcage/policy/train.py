@@ -100,7 +100,7 @@ class Run:
     def __init__(self, data: TrainingData, config: TrainConfig, normalization: dict[str, Normalizer],
                  device: torch.device, graph: bool = False) -> None:
         self.data, self.config, self.normalization, self.device = data, config, normalization, device
-        windows = make_windows(data.lengths, config.n_obs_steps, config.horizon)
+        windows = make_windows(data.lengths, config.n_obs_steps, config.horizon, config.obs_stride)
         self.obs_index = torch.from_numpy(windows.obs)
         self.action_index = torch.from_numpy(windows.action)
         self.obs = torch.from_numpy(normalization["obs"].normalize(data.obs)).to(device)
