@@ -6,7 +6,10 @@ frame of subtask ``--subtask`` (earlier subtasks counted done) and rolls the pol
 It prints how many episodes complete that subtask and how many the whole plan, and in how many the
 earlier subtasks' work is no longer in place at the end (the policy went back to it: a mouse
 picked off its pad again). A subtask-conditioned policy also reports the subtask its classifier
-named at the first chunk.
+named at the first chunk. When the subtask's skill names an object (``obj``) and the observations
+carry the tool's pose and the objects' poses, it prints where the hand came lowest: how high above
+that object's origin (where it stood when the subtask began) and how far from it across the table,
+beside the same for the demonstration (a press that stops short, or lands beside the button).
 
     LP_NUM_THREADS=1 .venv/bin/python benchmarks/policy_subtask_starts.py RUN --subtask 1 --episodes 20
 """
@@ -15,6 +18,9 @@ from __future__ import annotations
 
 import argparse
 from pathlib import Path
+from typing import Any
+
+import numpy as np
 
 
 def main() -> None:
@@ -28,7 +34,6 @@ def main() -> None:
     parser.add_argument("--seed", type=int, default=0, help="seed of the sampler's noise")
     args = parser.parse_args()
 
-    import numpy as np
     import torch
 
     from vcage.data.reader import DatasetReader
@@ -48,7 +53,9 @@ def main() -> None:
     if not 0 < args.subtask < len(goal.plan.subtasks):
         parser.error(f"--subtask must be a later subtask of the plan: 1 to {len(goal.plan.subtasks) - 1}")
     runner = PolicyRunner(payload, seed=args.seed)
+    obj = goal.plan.subtasks[args.subtask].args.get("obj")
     done = undone = named_right = started_done = 0
+    misses: dict[bool, list[float]] = {True: [], False: []}
     episodes = min(args.episodes, reader.num_episodes)
     steps = []
     for k in range(episodes):
@@ -57,20 +64,35 @@ def main() -> None:
         runner.reset(episode_noise_seed(args.seed, k))
         obs, info = env.reset(options={"scene_seed": extras["seed"], "subtask": args.subtask,
                                        "state": reader.arrays(k)["states"][start]})
+        where = object_position(reader, obs, obj)
         first, t, terminated, truncated = None, 0, False, False
+        hand = []
         while not (terminated or truncated):
             obs, _, terminated, truncated, info = env.step(runner.act(obs))
             first = runner.subtask if first is None else first
             t += 1
+            if EE in obs:
+                hand.append(np.asarray(obs[EE], dtype=float)[:3])
         back = not all(goal.holds(j) for j in range(args.subtask))
         done += bool(info["success"])
         started_done += info["subtasks_done"] > args.subtask
         undone += back
         named_right += first == args.subtask
         steps.append(t)
+        reach = ""
+        if where is not None and hand:
+            frames = reader.episode(k).frames
+            span = extras["subtasks"][args.subtask]["frames"]
+            demo = lowest(np.asarray(frames[EE], dtype=float)[span[0]:span[1], :3], where)
+            ours = lowest(np.array(hand), where)
+            misses[bool(info["success"])].append(ours[1])
+            reach = (f"; hand lowest {ours[0] * 1000:.0f} mm above the {obj} at ({where[0]:.2f}, "
+                     f"{where[1]:.2f}), {ours[1] * 1000:.0f} mm beside it (demo {demo[0] * 1000:.0f}, "
+                     f"{demo[1] * 1000:.0f})")
         print(f"  episode {k}: {'completed' if info['success'] else 'not completed'} in {t} steps"
               f"{'; earlier work undone' if back else ''}"
-              f"{f'; classifier named subtask {first} first' if runner.model.subtasks else ''}", flush=True)
+              f"{f'; classifier named subtask {first} first' if runner.model.subtasks else ''}{reach}",
+              flush=True)
     print(f"{payload['path']}")
     print(f"started at subtask {args.subtask} of {len(goal.plan.subtasks)} from {episodes} demonstrations of "
           f"{reader.root} (their own training scenes): subtask {args.subtask} done in "
@@ -78,6 +100,30 @@ def main() -> None:
           f"{undone}/{episodes}, median {int(np.median(steps))} steps"
           + (f"; classifier named subtask {args.subtask} at the first chunk in {named_right}/{episodes}"
              if runner.model.subtasks else ""))
+    for success, values in misses.items():
+        if values:
+            print(f"{'completed' if success else 'not completed'}: the hand came lowest a median "
+                  f"{np.median(values) * 1000:.0f} mm beside the {obj} (range {min(values) * 1000:.0f}-"
+                  f"{max(values) * 1000:.0f} mm, {len(values)} starts)")
+
+
+EE, ENV_STATE = "observation.ee_pose", "observation.environment_state"
+
+
+def object_position(reader: Any, obs: dict[str, Any], obj: str | None) -> np.ndarray | None:
+    """The position of ``obj`` in an observation, or None without one (no object, no such feature)."""
+    feature = reader.features.get(ENV_STATE)
+    names = list(feature.names or ()) if feature is not None else []
+    if obj is None or f"{obj}.x" not in names or ENV_STATE not in obs or EE not in obs:
+        return None
+    at = names.index(f"{obj}.x")
+    return np.asarray(obs[ENV_STATE], dtype=float)[at:at + 3]
+
+
+def lowest(hand: np.ndarray, where: np.ndarray) -> tuple[float, float]:
+    """Height above ``where`` and distance from it across the table of the lowest of ``hand`` (T, 3)."""
+    i = int(np.argmin(hand[:, 2]))
+    return float(hand[i, 2] - where[2]), float(np.linalg.norm(hand[i, :2] - where[:2]))
 
 
 if __name__ == "__main__":
