@@ -39,6 +39,7 @@ def main() -> None:
     from vcage.data.reader import DatasetReader
     from vcage.pipeline.evaluation import make_env
     from vcage.policy.checkpoint import load_checkpoint
+    from vcage.policy.dataset import fingerprint
     from vcage.policy.evaluate import check_compatible, episode_noise_seed
     from vcage.policy.inference import PolicyRunner
 
@@ -93,9 +94,11 @@ def main() -> None:
               f"{'; earlier work undone' if back else ''}"
               f"{f'; classifier named subtask {first} first' if runner.model.subtasks else ''}{reach}",
               flush=True)
+    own = fingerprint(reader) == payload["dataset"]["fingerprint"]
+    whose = "the policy's own training scenes" if own else "not the policy's training data"
     print(f"{payload['path']}")
     print(f"started at subtask {args.subtask} of {len(goal.plan.subtasks)} from {episodes} demonstrations of "
-          f"{reader.root} (their own training scenes): subtask {args.subtask} done in "
+          f"{reader.root} ({whose}): subtask {args.subtask} done in "
           f"{started_done}/{episodes}, plan completed in {done}/{episodes}, earlier work undone in "
           f"{undone}/{episodes}, median {int(np.median(steps))} steps"
           + (f"; classifier named subtask {args.subtask} at the first chunk in {named_right}/{episodes}"
