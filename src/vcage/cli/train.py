@@ -35,7 +35,8 @@ def train_cmd(
                                         "current one and those before it (default 2); the actions executed "
                                         "from the current frame on must fit in the 16-step chunk"),
         obs_stride: int = typer.Option(None, min=1, help="frames between two observed frames (default 1): "
-                                       "with --n-obs-steps 8 --obs-stride 4 the policy sees 1.45 s back"),
+                                       "with --n-obs-steps 8 --obs-stride 4 the policy sees 28 frames back "
+                                       "(1.4 s at 20 Hz)"),
         rotations: str = typer.Option(None, help="how the policy reads quaternions: rot6d (default: "
                                       "rotation-matrix columns, continuous) or quaternion (as stored)"),
         keep_checkpoints: int = typer.Option(None, min=1, help="keep only this many newest checkpoints "
