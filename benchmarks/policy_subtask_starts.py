@@ -38,6 +38,7 @@ def main() -> None:
 
     from vcage.data.reader import DatasetReader
     from vcage.pipeline.evaluation import make_env
+    from vcage.pipeline.features import EE_POSE
     from vcage.policy.checkpoint import load_checkpoint
     from vcage.policy.dataset import fingerprint
     from vcage.policy.evaluate import check_compatible, episode_noise_seed
@@ -60,20 +61,21 @@ def main() -> None:
     episodes = min(args.episodes, reader.num_episodes)
     steps = []
     for k in range(episodes):
-        extras = reader.extras(k)
+        episode = reader.episode(k)
+        extras = episode.extras
         start = extras["subtasks"][args.subtask]["frames"][0]
         runner.reset(episode_noise_seed(args.seed, k))
         obs, info = env.reset(options={"scene_seed": extras["seed"], "subtask": args.subtask,
-                                       "state": reader.arrays(k)["states"][start]})
-        where = object_position(reader, obs, obj)
+                                       "state": episode.arrays["states"][start]})
+        where = object_position(goal.plan, obs, obj)
         first, t, terminated, truncated = None, 0, False, False
         hand = []
         while not (terminated or truncated):
             obs, _, terminated, truncated, info = env.step(runner.act(obs))
             first = runner.subtask if first is None else first
             t += 1
-            if EE in obs:
-                hand.append(np.asarray(obs[EE], dtype=float)[:3])
+            if EE_POSE in obs:
+                hand.append(np.asarray(obs[EE_POSE], dtype=float)[:3])
         back = not all(goal.holds(j) for j in range(args.subtask))
         done += bool(info["success"])
         started_done += info["subtasks_done"] > args.subtask
@@ -82,9 +84,8 @@ def main() -> None:
         steps.append(t)
         reach = ""
         if where is not None and hand:
-            frames = reader.episode(k).frames
             span = extras["subtasks"][args.subtask]["frames"]
-            demo = lowest(np.asarray(frames[EE], dtype=float)[span[0]:span[1], :3], where)
+            demo = lowest(np.asarray(episode.frames[EE_POSE], dtype=float)[span[0]:span[1], :3], where)
             ours = lowest(np.array(hand), where)
             misses[bool(info["success"])].append(ours[1])
             reach = (f"; hand lowest {ours[0] * 1000:.0f} mm above the {obj} at ({where[0]:.2f}, "
@@ -110,17 +111,13 @@ def main() -> None:
                   f"{max(values) * 1000:.0f} mm, {len(values)} starts)")
 
 
-EE, ENV_STATE = "observation.ee_pose", "observation.environment_state"
-
-
-def object_position(reader: Any, obs: dict[str, Any], obj: str | None) -> np.ndarray | None:
+def object_position(plan: Any, obs: dict[str, Any], obj: str | None) -> np.ndarray | None:
     """The position of ``obj`` in an observation, or None without one (no object, no such feature)."""
-    feature = reader.features.get(ENV_STATE)
-    names = list(feature.names or ()) if feature is not None else []
-    if obj is None or f"{obj}.x" not in names or ENV_STATE not in obs or EE not in obs:
+    from vcage.pipeline.features import EE_POSE, ENVIRONMENT, pose_slice
+
+    if obj is None or ENVIRONMENT not in obs or EE_POSE not in obs:
         return None
-    at = names.index(f"{obj}.x")
-    return np.asarray(obs[ENV_STATE], dtype=float)[at:at + 3]
+    return np.asarray(obs[ENVIRONMENT], dtype=float)[pose_slice(plan, obj)][:3]
 
 
 def lowest(hand: np.ndarray, where: np.ndarray) -> tuple[float, float]:

@@ -24,8 +24,6 @@ from typing import Any
 
 import numpy as np
 
-ENV_STATE = "observation.environment_state"
-
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
@@ -56,7 +54,6 @@ def main() -> None:
                    action=payload["action_feature"]["name"])
     plan = env.unwrapped.plan
     n = len(plan.subtasks)
-    names = next((f.get("names") for f in payload["obs_features"] if f["name"] == ENV_STATE), None) or []
     done_at: list[list[int | None]] = []
     moved_at: list[list[int | None]] = []
     apart: list[list[float | None]] = []
@@ -75,7 +72,7 @@ def main() -> None:
                 moved[j] = t if moved[j] is None else moved[j]
         done_at.append(done)
         moved_at.append(moved)
-        apart.append([distance(obs, names, s.args) for s in plan.subtasks])
+        apart.append([distance(plan, obs, s.args) for s in plan.subtasks])
         print(f"  scene {k}: {int(info.get('subtasks_done', 0))}/{n} subtasks in {t} steps; done at "
               f"{done}, classifier moved on at {moved[1:]}", flush=True)
     print(f"{payload['path']}: {len(scenes)} held-out scenes")
@@ -93,14 +90,15 @@ def main() -> None:
               f"{len(stuck)}{where}; moved on without it in {len(early)}")
 
 
-def distance(obs: dict[str, Any], names: list[str], args: dict[str, Any]) -> float | None:
+def distance(plan: Any, obs: dict[str, Any], args: dict[str, Any]) -> float | None:
     """How far the subtask's object lies from its target's centre across the table (None: no such pair)."""
+    from vcage.pipeline.features import ENVIRONMENT, pose_slice
+
     obj, target = args.get("obj"), args.get("target")
-    if not obj or not target or f"{obj}.x" not in names or f"{target}.x" not in names or ENV_STATE not in obs:
+    if not obj or not target or ENVIRONMENT not in obs:
         return None
-    state = np.asarray(obs[ENV_STATE], dtype=float)
-    a, b = names.index(f"{obj}.x"), names.index(f"{target}.x")
-    return float(np.linalg.norm(state[a:a + 2] - state[b:b + 2]))
+    state = np.asarray(obs[ENVIRONMENT], dtype=float)
+    return float(np.linalg.norm(state[pose_slice(plan, obj)][:2] - state[pose_slice(plan, target)][:2]))
 
 
 if __name__ == "__main__":

@@ -267,3 +267,14 @@ def test_an_environment_given_held_out_scenes_builds_exactly_those(made: Path) -
     assert [env.reset()[1]["scene_seed"] for _ in range(3)] == [chosen[0], chosen[1], chosen[0]]
     with pytest.raises(ConfigError, match="scenes"):
         make_env(config, scenes=[])
+
+
+def test_an_objects_pose_is_read_where_the_environment_state_names_it() -> None:
+    from vcage.pipeline.features import ENVIRONMENT, dataset_features, pose_slice
+    from vcage.planning.offline import OfflinePlanner
+
+    plan = OfflinePlanner().plan("put the mouse on the pad, then press the bell")
+    names = dataset_features(plan)[ENVIRONMENT].names
+    for obj in ("mouse", "bell"):
+        pose = [f"{obj}.{c}" for c in ("x", "y", "z", "qw", "qx", "qy", "qz")]
+        assert list(names[pose_slice(plan, obj)]) == pose

@@ -43,6 +43,12 @@ def objects_of(plan: Plan) -> list[str]:
     return [o.name for o in plan.objects]
 
 
+def pose_slice(plan: Plan, name: str) -> slice:
+    """Where object ``name``'s pose (x, y, z, qw, qx, qy, qz) lies in the environment state of ``plan``."""
+    at = objects_of(plan).index(name) * len(POSE)
+    return slice(at, at + len(POSE))
+
+
 def dataset_features(plan: Plan) -> dict[str, Feature]:
     """The per-frame vector features of a dataset made for ``plan`` (cameras come on top)."""
     return {
