@@ -49,13 +49,18 @@ def on(world: World, obj: str, target: str, placement: str | None = None) -> boo
     (a target tipped over has no placement surface to rest on: the region's frame would lie beside
     it, where an object standing next to a tipped target would count as on it; a cube's surface is
     the face that is up). ``obj`` rests on its base, its origin (the base's centre) on the surface;
-    a cube (``any_face``) on whichever face is down: its lowest point and its centre count."""
+    a cube (``any_face``) on whichever face is down: its lowest point and its centre count.
+
+    And ``obj`` touches ``target``: over the region and low enough is not resting on it when
+    something else holds ``obj`` up (a cup standing in a basket whose floor lies over a coaster
+    beneath it, a few millimetres above the coaster's top, as Vanilla's scenes compose them)."""
     center, rot, half, _ = placement_frame(world, target, placement)
     if CATALOG.get(world.object(obj).type_name).any_face:
         dz, point = world.object_lowest(obj, rot[:, 2], center), world.object_com(obj)
     else:
         dz, point = world.object_pos(obj)[2] - center[2], world.object_pos(obj)
-    return _faces_up(rot) and -0.01 <= dz <= Z_TOL and _in_region(point, center, rot, half)
+    return (_faces_up(rot) and -0.01 <= dz <= Z_TOL and _in_region(point, center, rot, half)
+            and contact_between(world, obj, target))
 
 
 def inside(world: World, obj: str, container: str, placement: str | None = None) -> bool:
