@@ -210,6 +210,31 @@ def test_a_mouse_standing_on_its_end_on_the_pad_is_not_on_it() -> None:
         verdict.reason
 
 
+CUP_COASTER = (O("cup", "cup", (0.5, -0.12)), O("coaster", "coaster", (0.58, 0.1)))
+
+
+def test_a_cup_lying_on_its_side_across_the_coaster_is_not_on_it() -> None:
+    """Vanilla rollouts left cups lying on their sides across the coaster (the oracle: not on it, the
+    base's centre 4 cm up): from the top most of the cup lies over the coaster, its lowest point is
+    down on it, and it is round either way up. Its top, 7 cm above the coaster where it stood 9 cm
+    tall, is nearer lying than standing."""
+    oracle, verdict = _set_down(CUP_COASTER, put_on("cup", "coaster", "the cup is on the coaster"),
+                                O("cup", "cup", (0.58, 0.145), z=0.85),
+                                (np.cos(np.pi / 4), np.sin(np.pi / 4), 0.0, 0.0))  # a quarter turn about x
+    assert not oracle
+    assert not verdict.accept and "lies on its side" in verdict.reason, verdict.reason
+
+
+def test_a_cup_standing_on_the_coaster_is_on_it_whatever_its_scale() -> None:
+    """The side check reads the cup's scale from its height before: a small cup standing on the
+    coaster is not taken for a large one lying down."""
+    small = (O("cup", "cup", (0.5, -0.12), scale=0.9), O("coaster", "coaster", (0.58, 0.1)))
+    oracle, verdict = _set_down(small, put_on("cup", "coaster", "the cup is on the coaster"),
+                                O("cup", "cup", (0.58, 0.1), z=0.8, scale=0.9), (1.0, 0.0, 0.0, 0.0))
+    assert oracle
+    assert verdict.accept, verdict.reason
+
+
 def test_a_loaf_upside_down_in_the_basket_is_inside_it() -> None:
     """A Vanilla rollout left a loaf standing on its end in the basket: inside it for the oracle, but
     its top, a flat end where the crust had been curved, was read as turned over. On a surface that

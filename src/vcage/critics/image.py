@@ -135,6 +135,9 @@ FLAT_BEND = 0.6
 # of its type's footprint (size x by size y, times its smallest and largest scale squared); a round
 # or rounded object covers about 0.8 of it
 FOOTPRINT = (0.6, 1.15)
+# on its side: metres by which an object's height standing must exceed its top lying on a side (its
+# longest side across) for the top view's heights to tell the two (a cup: 2 cm at scale 1)
+SIDE_GAP = 0.01
 # facing: the oracle's tolerance (radians); the tall part's long/short spread; the front view's
 # luminance P90/P10 over the object's upper part above which its detailed face shows to the front
 # camera (plain backs measured 1.0-1.9, a board's code and a fan's grille 4.5 and more); the fewest
@@ -252,7 +255,8 @@ def _rests_on(obs: Observation, a: str, b: str, inside: bool) -> tuple[bool, str
     if not centroid_in(ma, mb, CENTRE_TOL):
         return False, f"the centre of {a} is not over {b} from the top"
     # in a container an object may lie any way up; on a surface, turned over it does not rest on its base
-    other = _landed_on_other(obs, top, a, b, inside) or (None if inside else _turned_over(obs, top, a))
+    other = _landed_on_other(obs, top, a, b, inside) or (
+        None if inside else _turned_over(obs, top, a) or _on_its_side(obs, top, a, b))
     if other is not None:
         return False, other
     fa, fb = rows_of(_mask(obs, front, a)), rows_of(_mask(obs, front, b) | _mask(obs, front, a))
@@ -320,14 +324,11 @@ def _on_rim(obs: Observation, top: View, a: str, b: str,
     hb, ha = (_heights(before), _heights(top)) if before is not None else (None, None)
     if before is None or hb is None or ha is None:
         return None
-    was, now, mb = _mask(obs, before, a), _mask(obs, top, a), _mask(obs, before, b)
-    ring = dilate(was, 2) & ~dilate(was, 1) & (before.segmentation == -1)
-    if not was.any() or not now.any() or not mb.any():
+    now, mb = _mask(obs, top, a), _mask(obs, before, b)
+    own = _own_height(obs, a)
+    if own is None or not now.any() or not mb.any():
         return None
-    if ring.sum() < UNDER_PX or float(np.median(hb[ring])) > HEIGHT_TOL:
-        return None  # not seen standing on the table before: its own height is not known
     rim = float(np.percentile(hb[mb], RIM_PERCENTILE))
-    own = _highest(hb, was)
     if lean is not None:
         heights, plane, slope = lean
         low_end = float(np.percentile(heights[plane <= np.percentile(plane, 25)], 95))
@@ -337,6 +338,61 @@ def _on_rim(obs: Observation, top: View, a: str, b: str,
     if under < RIM_GAP:
         where = f"{100 * under:.1f} cm under" if under >= 0 else f"{-100 * under:.1f} cm above"
         return f"{a}'s underside is {where} {b}'s rim: it rests on the rim or on something, not down in {b}"
+    return None
+
+
+def _own_height(obs: Observation, a: str, outline: bool = False) -> float | None:
+    """``a``'s own height: its highest point before the subtask, where the top view (with depth) saw
+    it standing on the table (the ring of pixels around it at the table's height); None if it did not
+    (it stood on something, or nothing around it shows). ``outline``: its outline's pixels (their
+    median) count too: an open container's highest point is its rim, one or two pixels wide at its
+    outline, around a floor seen from above (a silhouette pixel's depth alone may be far off, see
+    :func:`_inner`)."""
+    before = obs.before.get(TOP)
+    hb = _heights(before) if before is not None else None
+    if before is None or hb is None:
+        return None
+    was = _mask(obs, before, a)
+    ring = dilate(was, 2) & ~dilate(was, 1) & (before.segmentation == -1)
+    if not was.any() or ring.sum() < UNDER_PX or float(np.median(hb[ring])) > HEIGHT_TOL:
+        return None
+    own = _highest(hb, was)
+    edge = was & dilate(~was, 1)
+    return max(own, float(np.median(hb[edge]))) if outline and edge.any() else own
+
+
+def _on_its_side(obs: Observation, top: View, a: str, b: str) -> str | None:
+    """Why ``a`` lies on its side on ``b`` instead of standing on its base (None if it does not, or
+    the views cannot tell). ``a`` stood on its base on the table before (its top-view area within
+    :data:`FOOTPRINT` of its type's, its own height known, see :func:`_own_height`, and within its
+    type's heights), which gives its scale; lying on a side its top stands at most its longest side across (at that scale) above
+    ``b``'s surface. Where that is at least :data:`SIDE_GAP` lower than its own height (a cup: 7 cm
+    across, 9 cm tall), a top nearer the lying height than the standing one lies on its side: a
+    tilted object (a cup leaning on its rim's edge) stands at least as high as one of the two, a
+    cylinder tipped by an angle reaching its height times the cosine plus its diameter times the
+    sine. Objects that carry on any face (cubes) and objects not taller than wide are not judged."""
+    otype = _type_of(obs, a)
+    before = obs.before.get(TOP)
+    hb, ha = (_heights(before), _heights(top)) if before is not None else (None, None)
+    own = _own_height(obs, a, outline=True)
+    if otype is None or otype.any_face or before is None or before.pixel_size is None or hb is None \
+            or ha is None or own is None:
+        return None
+    was, now, mb = _mask(obs, before, a), _mask(obs, top, a), _mask(obs, before, b)
+    share = was.sum() * before.pixel_size ** 2 / (otype.size[0] * otype.size[1])
+    lo, hi = otype.scale_range
+    if not now.any() or not mb.any() or not FOOTPRINT[0] * lo ** 2 <= share <= FOOTPRINT[1] * hi ** 2:
+        return None
+    if not otype.size[2] * lo - UPRIGHT_TOL <= own <= otype.size[2] * hi + UPRIGHT_TOL:
+        return None  # not the height of its type standing on its base: it leaned, or stood on something
+    lying = max(otype.size[0], otype.size[1]) * own / otype.size[2]
+    surface = _surface(obs, b, float(hb[_inner(mb)].max()))
+    if own - lying < SIDE_GAP or surface is None:
+        return None
+    high = float(np.percentile(ha[now], 95)) - surface
+    if high < (own + lying) / 2:
+        return (f"{a}'s top is {100 * high:.1f} cm above {b}'s surface, {100 * own:.1f} cm standing and "
+                f"{100 * lying:.1f} cm lying: it lies on its side")
     return None
 
 
