@@ -153,14 +153,15 @@ def test_an_object_put_down_on_clutter_that_lies_on_its_target_is_not_on_it() ->
 
 
 def _set_down(scene: tuple[O, ...], subtask: Subtask, placed: O, quat: tuple[float, float, float, float],
-              extra: tuple[O, ...] = ()) -> tuple[bool, Verdict]:
+              extra: tuple[O, ...] = (), moved: tuple[O, ...] = ()) -> tuple[bool, Verdict]:
     """The oracle's and the critic's verdicts on ``subtask`` done as planned in ``scene``, with the
-    "after" views replaced by the same scene (and the objects ``extra``, unlabelled) with ``placed``
-    dropped from its ``z`` in orientation ``quat`` and settled (no injected fault leaves an object
-    in such a pose reliably)."""
+    "after" views replaced by the same scene (and the objects ``extra``, unlabelled; ``moved`` in
+    place of the scene's objects of the same names) with ``placed`` dropped from its ``z`` in
+    orientation ``quat`` and settled (no injected fault leaves an object in such a pose reliably)."""
     done = run(scene, subtask)
     assert done.success and CRITIC.judge(done.obs).accept
-    others = tuple(o for o in scene if o.name != placed.name)
+    instead = {o.name: o for o in moved}
+    others = tuple(instead.get(o.name, o) for o in scene if o.name != placed.name)
     assert scene[0].name == placed.name  # the segmentation labels keep their order
     world = compose(SceneSpec(objects=(placed, *others, *extra))).make_world()
     adr = world.model.jnt_qposadr[world.model.body_jntadr[world.object(placed.name).body_id]]
@@ -221,6 +222,18 @@ def test_a_cup_lying_on_its_side_across_the_coaster_is_not_on_it() -> None:
     oracle, verdict = _set_down(CUP_COASTER, put_on("cup", "coaster", "the cup is on the coaster"),
                                 O("cup", "cup", (0.58, 0.145), z=0.85),
                                 (np.cos(np.pi / 4), np.sin(np.pi / 4), 0.0, 0.0))  # a quarter turn about x
+    assert not oracle
+    assert not verdict.accept and "lies on its side" in verdict.reason, verdict.reason
+
+
+def test_a_cup_lying_on_its_side_over_a_coaster_it_hides_is_not_on_it() -> None:
+    """Where the cup hides most of a coaster that moved (knocked as the cup fell), the top view cannot
+    say where the coaster is, and the front view decides whether the cup rests on it; lying on its
+    side, it is not on it all the same."""
+    oracle, verdict = _set_down(CUP_COASTER, put_on("cup", "coaster", "the cup is on the coaster"),
+                                O("cup", "cup", (0.58, 0.145), z=0.85),
+                                (np.cos(np.pi / 4), np.sin(np.pi / 4), 0.0, 0.0),
+                                moved=(O("coaster", "coaster", (0.585, 0.11)),))
     assert not oracle
     assert not verdict.accept and "lies on its side" in verdict.reason, verdict.reason
 

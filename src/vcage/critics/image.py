@@ -16,7 +16,9 @@ simulator state. Each predicate is checked in image space:
   above ``b``'s surface (for ``inside``, its rim), and it does not lie over another object that
   stood higher than that surface before the subtask (clutter on the target); an object that stood on
   its base with a curved top before and shows a flat one now, or a domed one that barely bends now,
-  lies turned over (not asked in a container, where it may lie any way up). Put down on a surface
+  lies turned over, and one taller than wide whose top is now nearer its height lying on a side than
+  its height standing (read before, on the table) lies on its side (neither asked in a container,
+  where it may lie any way up; the side is asked also where ``a`` hides ``b``). Put down on a surface
   that does not lean, ``a``'s top stands no higher than its type's height above that surface (in a
   container, where its top view shows it turned or its top slopes as a leaning object's does, its
   longest side above the rim). In a container its underside, its own height (seen on the table
@@ -244,7 +246,8 @@ def _rests_on(obs: Observation, a: str, b: str, inside: bool) -> tuple[bool, str
     if not ma.any():
         return False, f"{a} is not visible from the top"
     if _covered(obs, top, b):  # from the top ``b`` is (mostly) hidden: where it is, the front view says
-        return _front_support(obs, front, a, b)
+        side = None if inside else _on_its_side(obs, top, a, b)  # a cup lying across a coaster hides it
+        return (False, side) if side is not None else _front_support(obs, front, a, b)
     if not mb.any():
         return False, f"{b} is not visible from the top"
     small, big = (ma, mb) if ma.sum() <= mb.sum() else (mb, ma)
@@ -365,12 +368,13 @@ def _on_its_side(obs: Observation, top: View, a: str, b: str) -> str | None:
     """Why ``a`` lies on its side on ``b`` instead of standing on its base (None if it does not, or
     the views cannot tell). ``a`` stood on its base on the table before (its top-view area within
     :data:`FOOTPRINT` of its type's, its own height known, see :func:`_own_height`, and within its
-    type's heights), which gives its scale; lying on a side its top stands at most its longest side across (at that scale) above
-    ``b``'s surface. Where that is at least :data:`SIDE_GAP` lower than its own height (a cup: 7 cm
-    across, 9 cm tall), a top nearer the lying height than the standing one lies on its side: a
-    tilted object (a cup leaning on its rim's edge) stands at least as high as one of the two, a
-    cylinder tipped by an angle reaching its height times the cosine plus its diameter times the
-    sine. Objects that carry on any face (cubes) and objects not taller than wide are not judged."""
+    type's heights), which gives its scale. Lying on a side, its top stands at most its longest side
+    across (at that scale) above ``b``'s surface. Where that is at least :data:`SIDE_GAP` lower than
+    its own height (a cup: 7 cm across, 9 cm tall), a top nearer the lying height than the standing
+    one lies on its side. A tilted object (a cup leaning on its rim's edge) stands at least as high
+    as the lower of the two: a cylinder tipped by an angle reaches its height times the cosine plus
+    its diameter times the sine. Objects that carry on any face (cubes) and objects not taller than
+    wide are not judged."""
     otype = _type_of(obs, a)
     before = obs.before.get(TOP)
     hb, ha = (_heights(before), _heights(top)) if before is not None else (None, None)
