@@ -383,10 +383,9 @@ def _on_its_side(obs: Observation, top: View, a: str, b: str) -> str | None:
             or ha is None or own is None:
         return None
     was, now, mb = _mask(obs, before, a), _mask(obs, top, a), _mask(obs, before, b)
-    share = was.sum() * before.pixel_size ** 2 / (otype.size[0] * otype.size[1])
-    lo, hi = otype.scale_range
-    if not now.any() or not mb.any() or not FOOTPRINT[0] * lo ** 2 <= share <= FOOTPRINT[1] * hi ** 2:
+    if not now.any() or not mb.any() or not _on_its_base(otype, before, was):
         return None
+    lo, hi = otype.scale_range
     if not otype.size[2] * lo - UPRIGHT_TOL <= own <= otype.size[2] * hi + UPRIGHT_TOL:
         return None  # not the height of its type standing on its base: it leaned, or stood on something
     lying = max(otype.size[0], otype.size[1]) * own / otype.size[2]
@@ -484,9 +483,7 @@ def _turned_over(obs: Observation, top: View, a: str) -> str | None:
             or any(p.kind == "in" for p in otype.placements)):
         return None
     mask = _mask(obs, before, a)
-    lo, hi = otype.scale_range
-    share = mask.sum() * before.pixel_size ** 2 / (otype.size[0] * otype.size[1])
-    if not FOOTPRINT[0] * lo ** 2 <= share <= FOOTPRINT[1] * hi ** 2:
+    if not _on_its_base(otype, before, mask):
         return None  # not standing on its base before (a tilted block shows a side: two faces, no plane)
     was, now = _relief(before, mask), _relief(top, _mask(obs, top, a))
     if was is None or now is None or was < CURVED:
@@ -499,6 +496,16 @@ def _turned_over(obs: Observation, top: View, a: str) -> str | None:
         return None
     return (f"{a}'s top bends x{bend[0] / dome[0]:.2f} as much as before (a dome then): it lies turned "
             "over, or tipped onto its top")
+
+
+def _on_its_base(otype: ObjectType, view: View, mask: np.ndarray) -> bool:
+    """Whether ``mask``, an object of type ``otype`` in an orthographic view, covers what it covers
+    standing on its base: between the :data:`FOOTPRINT` shares of its type's footprint."""
+    if view.pixel_size is None:
+        return False
+    lo, hi = otype.scale_range
+    share = mask.sum() * view.pixel_size ** 2 / (otype.size[0] * otype.size[1])
+    return bool(FOOTPRINT[0] * lo ** 2 <= share <= FOOTPRINT[1] * hi ** 2)
 
 
 def _dome(view: View, mask: np.ndarray) -> tuple[float, float] | None:
