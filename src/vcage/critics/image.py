@@ -379,8 +379,7 @@ def _on_its_side(obs: Observation, top: View, a: str, b: str) -> str | None:
     before = obs.before.get(TOP)
     hb, ha = (_heights(before), _heights(top)) if before is not None else (None, None)
     own = _own_height(obs, a, outline=True)
-    if otype is None or otype.any_face or before is None or before.pixel_size is None or hb is None \
-            or ha is None or own is None:
+    if otype is None or otype.any_face or before is None or hb is None or ha is None or own is None:
         return None
     was, now, mb = _mask(obs, before, a), _mask(obs, top, a), _mask(obs, before, b)
     if not now.any() or not mb.any() or not _on_its_base(otype, before, was):
