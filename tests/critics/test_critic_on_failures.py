@@ -248,6 +248,17 @@ def test_a_cup_standing_on_the_coaster_is_on_it_whatever_its_scale() -> None:
     assert verdict.accept, verdict.reason
 
 
+def test_a_cup_moved_onto_the_middle_of_a_coaster_it_half_hid_is_on_it() -> None:
+    """A Vanilla rollout began with the cup standing off-centre on the coaster and ended with it in
+    the middle: the coaster's middle was hidden before and after, so its outline is a ring with
+    fewer pixels than the cup. The overlap is asked of the region smaller by its hull (the cup)."""
+    scene = (O("cup", "cup", (0.58, 0.08), z=0.755, scale=1.2), O("coaster", "coaster", (0.58, 0.1)))
+    done = run(scene, put_on("cup", "coaster", "the cup is on the coaster"))
+    assert done.success
+    verdict = CRITIC.judge(done.obs)
+    assert verdict.accept, verdict.reason
+
+
 def test_a_loaf_upside_down_in_the_basket_is_inside_it() -> None:
     """A Vanilla rollout left a loaf standing on its end in the basket: inside it for the oracle, but
     its top, a flat end where the crust had been curved, was read as turned over. On a surface that

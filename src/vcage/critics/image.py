@@ -92,7 +92,7 @@ from vcage.registry import Registry
 
 ROBOT = -2
 TOP, FRONT = "top", "front"
-MIN_OVERLAP = 0.6  # share of the smaller region's pixels that must overlap the other's hull
+MIN_OVERLAP = 0.6  # share of the smaller region's (by hull) pixels that must overlap the other's hull
 CENTRE_TOL = 2  # pixels (about 1 cm) by which an object's centre may lie outside its support's hull
 COVERED = 0.5  # share of its top-view area before below which an object counts as covered now
 STILL = 0.9  # share of an object's pixels within its outline before for it to count as not moved
@@ -250,8 +250,11 @@ def _rests_on(obs: Observation, a: str, b: str, inside: bool) -> tuple[bool, str
         return (False, side) if side is not None else _front_support(obs, front, a, b)
     if not mb.any():
         return False, f"{b} is not visible from the top"
-    small, big = (ma, mb) if ma.sum() <= mb.sum() else (mb, ma)
-    overlap = float((small & hull(big)).sum() / small.sum())
+    # which is smaller by hulls, not pixels: where ``a`` hid the middle of ``b`` before and hides it
+    # now, ``b``'s outline is a ring with fewer pixels than ``a`` though ``b`` is the larger
+    hull_a, hull_b = hull(ma), hull(mb)
+    small, big = (ma, hull_b) if hull_a.sum() <= hull_b.sum() else (mb, hull_a)
+    overlap = float((small & big).sum() / small.sum())
     btype = _type_of(obs, b)
     if overlap < MIN_OVERLAP and not (btype is not None and btype.any_face):
         return False, f"only {overlap:.0%} of {a} overlaps {b} from the top"
