@@ -403,6 +403,17 @@ def test_a_press_on_a_bell_the_front_view_never_shows_is_judged_from_the_top() -
     assert not verdict.accept and "short of pressing" in verdict.reason, verdict.reason
 
 
+def test_a_press_that_rocks_the_clock_is_refused() -> None:
+    """A clock standing with one side on a marker rocks down onto it under the hand (as clocks on
+    clutter did on Vanilla rollouts): the hand reads deeper than the button goes, though its cover
+    and depth pass and the clock shows as before from the top. The oracle: not upright."""
+    scene = (O("clock", "alarm_clock", (0.55, 0.05), z=0.765), O("marker", "marker", (0.55, 0.075)))
+    result = run(scene, press("clock", "the clock's button is pressed"))
+    assert result.outcome.oracle == {"pressed(clock)": True, "upright(clock)": False}
+    verdict = CRITIC.judge(result.obs)
+    assert not verdict.accept and "gave way under it" in verdict.reason, verdict.reason
+
+
 def test_a_press_is_judged_at_its_own_lowest_moment() -> None:
     """A sweep after the press (knocking nothing over here) takes the hand lower than the press did;
     the views "during" the subtask are still those of the press, which the critic accepts."""

@@ -36,9 +36,11 @@ simulator state. Each predicate is checked in image space:
   above the hand's centre between the fingertips when the hand points down (as it does to press),
   and at a full press that centre is :data:`FINGER_CONTACT` minus the button's travel (a lever's
   stroke), scaled by ``x``'s size, above ``x``'s highest point before. A press that stops short of
-  :data:`PRESS_SHARE` of that is refused. Where the hand goes down behind an object standing in front
-  of ``x`` (a cup before a bell), or ``x`` does not show in the front view at all, the front view
-  cannot show the contact; then the top view's cover and depth, both required, decide.
+  :data:`PRESS_SHARE` of that is refused, and so is one that reads more than :data:`PRESS_ROOM`
+  deeper than a full press: ``x`` gave way under the hand (it rocked or fell). Where the hand goes
+  down behind an object standing in front of ``x`` (a cup before a bell), or ``x`` does not show in
+  the front view at all, the front view cannot show the contact; then the top view's cover and
+  depth, both required, decide.
 - ``upright(x)``: ``x``'s top-view area (orthographic, so true to size wherever it stands) and the
   spread of its outline are close to what they were before, allowing for what the robot can hide;
   its highest point (the top view's depth; without it, its front-view height) did not drop, and
@@ -167,6 +169,13 @@ FINGER_CONTACT = 0.033  # metres
 # counted ones read down to 0.65 (0.75 refused two) and uncounted ones at most 0.15. 0.4 lies in
 # both gaps
 PRESS_SHARE = {"button": 0.4, "lever": 0.5}
+# How much deeper than a full press (metres) the hand may read before what it pressed counts as having
+# given way under it (tipped, slid or fallen): the press skill drives the fingertips this far past the
+# stroke, and a button or lever that stays put stops them short of that. On Vanilla rollouts (episodes
+# 324-377: 37 clocks, 46 bells) the presses the oracle counted read at most about 2 mm past a full
+# press; of four clocks it did not count, which rocked or fell as the hand came down, three read 4.6,
+# 8.2 and 46 mm past it (the fourth 3.8)
+PRESS_ROOM = 0.004
 # The hand pressing a button hides it from the top view: the object's top (its pixels within TOP_BAND
 # metres of its highest point, where the button or lever is) must be this much hidden by the robot
 TOP_BAND = 0.004
@@ -610,13 +619,19 @@ def _pressed(obs: Observation, x: str) -> tuple[bool, str]:
     outline = hull(mx_top) if mx_top.any() else mx_top
     if not np.any(dilate(top.segmentation == ROBOT, TOUCH) & outline):
         return False, f"the hand was not over {x}"
-    cover, short = _button_cover(obs, x), _press_shortfall(obs, x)
-    if hidden and (cover is None or short is None):
+    cover, reading = _button_cover(obs, x), _press_depth(obs, x)
+    if hidden and (cover is None or reading is None):
         return False, f"an object in front hides where the hand met {x}, and the top view cannot measure it"
     if cover is not None and cover < BUTTON_COVER:
         return False, f"the hand covered {cover:.0%} of {x}'s top (its button) at its lowest"
-    if short is not None and short > 0:
-        return False, f"the hand stopped {1000 * short:.1f} mm short of pressing {x} down its travel"
+    if reading is not None:
+        depth, full, share = reading
+        if depth < share * full:
+            return False, (f"the hand stopped {1000 * (share * full - depth):.1f} mm short of pressing {x} "
+                           "down its travel")
+        if depth > full + PRESS_ROOM:
+            return False, (f"the hand went {1000 * (depth - full):.1f} mm deeper than a full press of {x}: "
+                           f"{x} gave way under it (tipped, slid or fell)")
     return True, "the hand touched and covered it at its lowest"
 
 
@@ -687,9 +702,10 @@ def _button_cover(obs: Observation, x: str) -> float | None:
     return float(((during.segmentation == ROBOT) & top).sum() / top.sum())
 
 
-def _press_shortfall(obs: Observation, x: str) -> float | None:
-    """How far (metres) the hand stayed above :data:`PRESS_SHARE` of a full press of ``x`` at its
-    lowest (negative: deep enough); None where the views or ``x``'s type cannot tell."""
+def _press_depth(obs: Observation, x: str) -> tuple[float, float, float] | None:
+    """How far (metres) the hand pressed ``x`` down at its lowest (its fingertips under ``x``'s top
+    before), a full press of ``x`` and the share of it (:data:`PRESS_SHARE`) that must be reached;
+    None where the views or ``x``'s type cannot tell."""
     before, during = obs.before.get(TOP), obs.during.get(TOP)
     otype = _type_of(obs, x)
     if before is None or during is None or otype is None:
@@ -707,7 +723,7 @@ def _press_shortfall(obs: Observation, x: str) -> float | None:
     scale = top / point.pos[2]  # the press point at rest is the highest point
     full = (point.travel if point.kind == "button" else point.stroke) * scale
     tcp = float(hd[over].max()) - HAND_TOP
-    return (tcp - top) - (FINGER_CONTACT - PRESS_SHARE[point.kind] * full)
+    return top - (tcp - FINGER_CONTACT), full, PRESS_SHARE[point.kind]
 
 
 def _hidden(view: View, mask: np.ndarray) -> int:
