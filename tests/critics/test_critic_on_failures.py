@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 from critics.faulted import Run, run
-from vcage.critics.base import Verdict
+from vcage.critics.base import Verdict, View
 from vcage.critics.image import ROBOT, ImageCritic
 from vcage.critics.masks import touch
 from vcage.planning.goals import close_drawer, hang, open_drawer, press, put_in, put_on, turn_to_face
@@ -23,6 +23,7 @@ from vcage.scene.compose import compose
 from vcage.scene.spec import ObjectSpec as O
 from vcage.scene.spec import SceneSpec
 from vcage.sim.render import Renderer
+from vcage.sim.world import World
 from vcage.subtasks.judge import render_views
 from vcage.tasks import predicates as P
 
@@ -153,26 +154,37 @@ def test_an_object_put_down_on_clutter_that_lies_on_its_target_is_not_on_it() ->
 
 
 def _set_down(scene: tuple[O, ...], subtask: Subtask, placed: O, quat: tuple[float, float, float, float],
-              extra: tuple[O, ...] = (), moved: tuple[O, ...] = ()) -> tuple[bool, Verdict]:
+              extra: tuple[O, ...] = (), moved: tuple[O, ...] = (),
+              lay_before: tuple[O, tuple[float, float, float, float]] | None = None) -> tuple[bool, Verdict]:
     """The oracle's and the critic's verdicts on ``subtask`` done as planned in ``scene``, with the
     "after" views replaced by the same scene (and the objects ``extra``, unlabelled; ``moved`` in
     place of the scene's objects of the same names) with ``placed`` dropped from its ``z`` in
-    orientation ``quat`` and settled (no injected fault leaves an object in such a pose reliably)."""
+    orientation ``quat`` and settled (no injected fault leaves an object in such a pose reliably).
+    ``lay_before``: the "before" views replaced likewise, with ``placed`` there as given."""
     done = run(scene, subtask)
     assert done.success and CRITIC.judge(done.obs).accept
     instead = {o.name: o for o in moved}
     others = tuple(instead.get(o.name, o) for o in scene if o.name != placed.name)
-    assert scene[0].name == placed.name  # the segmentation labels keep their order
-    world = compose(SceneSpec(objects=(placed, *others, *extra))).make_world()
-    adr = world.model.jnt_qposadr[world.model.body_jntadr[world.object(placed.name).body_id]]
+    world, after = _settled((placed, *others, *extra), quat)
+    placing = [p for p in subtask.predicates if p.name != "released"]
+    oracle = all(P.ORACLE_CHECKS.get(p.name)(world, *p.args) for p in placing)
+    obs = replace(done.obs, after=after)
+    if lay_before is not None:
+        obs = replace(obs, before=_settled((lay_before[0], *scene[1:]), lay_before[1])[1])
+    return oracle, CRITIC.judge(obs)
+
+
+def _settled(objects: tuple[O, ...], quat: tuple[float, float, float, float]
+             ) -> tuple[World, dict[str, View]]:
+    """The scene of ``objects`` with the first dropped from its ``z`` in orientation ``quat``, settled,
+    and its views (the segmentation labels follow the objects' order)."""
+    world = compose(SceneSpec(objects=objects)).make_world()
+    adr = world.model.jnt_qposadr[world.model.body_jntadr[world.object(objects[0].name).body_id]]
     world.data.qpos[adr + 3:adr + 7] = quat
     world.forward()
     world.settle(1.0)
     with Renderer(world, 320, 240) as renderer:
-        after = render_views(renderer)
-    placing = [p for p in subtask.predicates if p.name != "released"]
-    oracle = all(P.ORACLE_CHECKS.get(p.name)(world, *p.args) for p in placing)
-    return oracle, CRITIC.judge(replace(done.obs, after=after))
+        return world, render_views(renderer)
 
 
 def _mouse_set_on_the_pad(quat: tuple[float, float, float, float], z: float) -> Verdict:
@@ -257,6 +269,23 @@ def test_a_cup_moved_onto_the_middle_of_a_coaster_it_half_hid_is_on_it() -> None
     assert done.success
     verdict = CRITIC.judge(done.obs)
     assert verdict.accept, verdict.reason
+
+
+SEAL_MAT = (O("seal", "seal", (0.5, -0.12)), O("mat", "stamp_mat", (0.58, 0.1)))
+
+
+def test_a_seal_that_lay_on_its_side_before_and_lies_so_on_the_mat_is_not_on_it() -> None:
+    """Vanilla rollouts (tidy the desk) left seals lying on their sides on the mat that lay so on the
+    table before the subtask already (the oracle: not on it, the base's centre 2.7 cm up): their
+    height before gives no scale, and their top shows no flat face it did not show before. A seal's
+    top, 4.8 cm above the mat there, is nearer its longest side across at any scale (5.5 cm) than the
+    least it stands on its base (9.6 cm)."""
+    lying = (float(np.cos(0.89)), float(np.sin(0.89)), 0.0, 0.0)  # 1.78 rad about x, as they lay
+    oracle, verdict = _set_down(SEAL_MAT, put_on("seal", "mat", "the seal is on the mat"),
+                                O("seal", "seal", (0.58, 0.13), z=0.8), lying,
+                                lay_before=(O("seal", "seal", (0.5, -0.12), z=0.8), lying))
+    assert not oracle
+    assert not verdict.accept and "lies on its side" in verdict.reason, verdict.reason
 
 
 def test_a_loaf_upside_down_in_the_basket_is_inside_it() -> None:

@@ -378,36 +378,46 @@ def _own_height(obs: Observation, a: str, outline: bool = False) -> float | None
 
 def _on_its_side(obs: Observation, top: View, a: str, b: str) -> str | None:
     """Why ``a`` lies on its side on ``b`` instead of standing on its base (None if it does not, or
-    the views cannot tell). ``a`` stood on its base on the table before (its top-view area within
-    :data:`FOOTPRINT` of its type's, its own height known, see :func:`_own_height`, and within its
-    type's heights), which gives its scale. Lying on a side, its top stands at most its longest side
-    across (at that scale) above ``b``'s surface. Where that is at least :data:`SIDE_GAP` lower than
-    its own height (a cup: 7 cm across, 9 cm tall), a top nearer the lying height than the standing
-    one lies on its side. A tilted object (a cup leaning on its rim's edge) stands at least as high
-    as the lower of the two: a cylinder tipped by an angle reaches its height times the cosine plus
-    its diameter times the sine. Objects that carry on any face (cubes) and objects not taller than
-    wide are not judged."""
+    the views cannot tell). Lying on a side, its top stands at most its longest side across above
+    ``b``'s surface; standing, its own height (see :func:`_standing_and_lying`). Where the first is
+    at least :data:`SIDE_GAP` lower than the second (a cup: 7 cm across, 9 cm tall), a top nearer the
+    lying height than the standing one lies on its side. A tilted object (a cup leaning on its rim's
+    edge) stands at least as high as the lower of the two: a cylinder tipped by an angle reaches its
+    height times the cosine plus its diameter times the sine. Objects that carry on any face (cubes)
+    and objects not taller than wide are not judged."""
     otype = _type_of(obs, a)
     before = obs.before.get(TOP)
     hb, ha = (_heights(before), _heights(top)) if before is not None else (None, None)
-    own = _own_height(obs, a, outline=True)
-    if otype is None or otype.any_face or before is None or hb is None or ha is None or own is None:
+    if otype is None or otype.any_face or before is None or hb is None or ha is None:
         return None
-    was, now, mb = _mask(obs, before, a), _mask(obs, top, a), _mask(obs, before, b)
-    if not now.any() or not mb.any() or not _on_its_base(otype, before, was):
+    now, mb = _mask(obs, top, a), _mask(obs, before, b)
+    if not now.any() or not mb.any():
         return None
-    lo, hi = otype.scale_range
-    if not otype.size[2] * lo - UPRIGHT_TOL <= own <= otype.size[2] * hi + UPRIGHT_TOL:
-        return None  # not the height of its type standing on its base: it leaned, or stood on something
-    lying = max(otype.size[0], otype.size[1]) * own / otype.size[2]
+    standing, lying = _standing_and_lying(obs, otype, before, a)
     surface = _surface(obs, b, float(hb[_inner(mb)].max()))
-    if own - lying < SIDE_GAP or surface is None:
+    if standing - lying < SIDE_GAP or surface is None:
         return None
     high = float(np.percentile(ha[now], 95)) - surface
-    if high < (own + lying) / 2:
-        return (f"{a}'s top is {100 * high:.1f} cm above {b}'s surface, {100 * own:.1f} cm standing and "
-                f"{100 * lying:.1f} cm lying: it lies on its side")
+    if high < (standing + lying) / 2:
+        return (f"{a}'s top is {100 * high:.1f} cm above {b}'s surface, {100 * standing:.1f} cm standing "
+                f"and {100 * lying:.1f} cm lying: it lies on its side")
     return None
+
+
+def _standing_and_lying(obs: Observation, otype: ObjectType, before: View, a: str) -> tuple[float, float]:
+    """How high ``a``'s top stands above what it rests on, standing on its base and lying on a side
+    (its longest side across). Where the top view saw ``a`` stand on its base on the table before
+    the subtask (its top-view area within :data:`FOOTPRINT` of its type's, its own height known, see
+    :func:`_own_height`, and within its type's heights), at the scale that height gives; otherwise
+    (it lay on its side already, leaned, or stood on something) the lowest standing and the highest
+    lying height its type's scales allow."""
+    lo, hi = otype.scale_range
+    across = max(otype.size[0], otype.size[1])
+    own = _own_height(obs, a, outline=True)
+    if (own is not None and _on_its_base(otype, before, _mask(obs, before, a))
+            and otype.size[2] * lo - UPRIGHT_TOL <= own <= otype.size[2] * hi + UPRIGHT_TOL):
+        return own, across * own / otype.size[2]
+    return otype.size[2] * lo, across * hi
 
 
 def _not_down(obs: Observation, top: View, a: str, surface: float | None, floor: float, where: str,
