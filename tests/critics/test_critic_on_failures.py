@@ -165,6 +165,7 @@ def _set_down(scene: tuple[O, ...], subtask: Subtask, placed: O, quat: tuple[flo
     assert done.success and CRITIC.judge(done.obs).accept
     instead = {o.name: o for o in moved}
     others = tuple(instead.get(o.name, o) for o in scene if o.name != placed.name)
+    assert scene[0].name == placed.name  # the segmentation labels keep their order
     world, after = _settled((placed, *others, *extra), quat)
     placing = [p for p in subtask.predicates if p.name != "released"]
     oracle = all(P.ORACLE_CHECKS.get(p.name)(world, *p.args) for p in placing)
