@@ -17,7 +17,8 @@ simulator state. Each predicate is checked in image space:
   stood higher than that surface before the subtask (clutter on the target); an object that stood on
   its base with a curved top before and shows a flat one now, or a domed one that barely bends now,
   lies turned over, and one taller than wide whose top is now nearer its height lying on a side than
-  its height standing (read before, on the table) lies on its side (neither asked in a container,
+  its height standing (read before, on the table; where it did not stand there, the bounds its
+  type's scales allow) lies on its side (neither asked in a container,
   where it may lie any way up; the side is asked also where ``a`` hides ``b``). Put down on a surface
   that does not lean, ``a``'s top stands no higher than its type's height above that surface (in a
   container, where its top view shows it turned or its top slopes as a leaning object's does, its
