@@ -19,6 +19,10 @@ whose denominator is empty prints "n/a" (not 0%).
 
 ``--mesh-detail full`` renders the critic's views with the robot's meshes as shipped (the default
 is the simplified meshes, as in a run).
+
+``--cache DIR`` stores every judged subtask's observation and the oracle's verdict (and re-uses
+them on the next run, so a changed critic is re-judged in seconds without simulating again; a
+change to anything else, skills or physics, needs a fresh directory).
 """
 
 from __future__ import annotations
@@ -29,9 +33,11 @@ import json
 import os
 import time
 from concurrent.futures import ProcessPoolExecutor
+from pathlib import Path
 
 os.environ.setdefault("LP_NUM_THREADS", "1")  # one rasteriser thread: a worker is one core
 
+from obs_cache import cached  # noqa: E402
 from vcage.config import MESH_DETAILS, RenderConfig  # noqa: E402
 from vcage.critics import Critic, CriticConfig, Observation, Verdict, make_critic  # noqa: E402
 from vcage.pipeline.config import GenerateConfig  # noqa: E402
@@ -44,36 +50,47 @@ DEFAULT_GOALS = ("get_ready_for_work", "prepare_breakfast", "tidy_the_desk", "se
 
 
 class Shadow(Critic):
-    """Asks ``inner`` and keeps its verdicts, but always lets the rollout go on."""
+    """Keeps the observations it is asked about, but always lets the rollout go on."""
 
-    def __init__(self, inner: Critic) -> None:
-        self.inner = inner
-        self.verdicts: list[Verdict] = []
-        self.needs_views = inner.needs_views
+    def __init__(self, needs_views: bool) -> None:
+        self.seen: list[Observation] = []
+        self.needs_views = needs_views
 
     def judge(self, obs: Observation) -> Verdict:
-        self.verdicts.append(self.inner.judge(obs))
+        self.seen.append(obs)
         return Verdict(True, "shadow: the rollout continues")
 
 
+Judged = tuple[str, Observation, bool, str, str]  # scene, observation, oracle success, where, oracle
 Row = tuple[str, str, bool, bool, str]  # goal, scene, critic accepts, oracle success, why
 
 
-def _run(job: tuple[str, int, str]) -> list[Row]:
-    goal, episode, mesh_detail = job
+def _rollout(goal: str, episode: int, mesh_detail: str) -> list[Judged]:
     phrase = next(g for g in GOALS if g.name == goal).phrasings[0]
     plan = make_planner("offline").plan(phrase)
     # episode k: the seed of the Vanilla run's episode k
     cfg = GenerateConfig.vanilla(seed=0, render=RenderConfig(mesh_detail=mesh_detail))
-    shadow = Shadow(make_critic(CriticConfig("image")))
+    shadow = Shadow(make_critic(CriticConfig("image")).needs_views)
     result = attempt(plan, cfg.episode_seed(episode, 0), cfg, shadow)
     if result.rollout is None:
         return []
     scene = hashlib.sha1(json.dumps(result.scene.to_dict() if result.scene else None, sort_keys=True,
                                     default=str).encode()).hexdigest()[:12]
     judged = [o for o in result.rollout.outcomes if o.verdict is not None]
-    return [(goal, scene, v.accept, o.oracle_success, f"seed {episode} subtask {o.index + 1}: {v.reason}; "
-             f"oracle {o.oracle}") for o, v in zip(judged, shadow.verdicts, strict=True)]
+    return [(scene, obs, o.oracle_success, f"seed {episode} subtask {o.index + 1}", str(o.oracle))
+            for o, obs in zip(judged, shadow.seen, strict=True)]
+
+
+def _run(job: tuple[str, int, str, str | None]) -> list[Row]:
+    goal, episode, mesh_detail, cache = job
+    path = Path(cache) / f"{goal}-{episode}-{mesh_detail}.pkl.gz" if cache else None
+    judged = cached(path, lambda: _rollout(goal, episode, mesh_detail))
+    critic = make_critic(CriticConfig("image"))
+    rows: list[Row] = []
+    for scene, obs, success, where, oracle in judged:
+        verdict = critic.judge(obs)
+        rows.append((goal, scene, verdict.accept, success, f"{where}: {verdict.reason}; oracle {oracle}"))
+    return rows
 
 
 def _pct(num: int, den: int, width: int = 7) -> str:
@@ -102,9 +119,10 @@ def main() -> None:
     parser.add_argument("--mesh-detail", choices=MESH_DETAILS, default=RenderConfig().mesh_detail,
                         help="how the critic's views draw the robot's meshes")
     parser.add_argument("--show-errors", action="store_true", help="print each disagreement")
+    parser.add_argument("--cache", default=None, help="directory for the judged subtasks' observations")
     args = parser.parse_args()
     seeds = range(args.first_seed, args.first_seed + args.seeds)
-    jobs = [(g, s, args.mesh_detail) for g in args.goals for s in seeds]
+    jobs = [(g, s, args.mesh_detail, args.cache) for g in args.goals for s in seeds]
     t0 = time.perf_counter()
     with ProcessPoolExecutor(args.workers) as pool:
         pairs = [p for rows in pool.map(_run, jobs) for p in rows]

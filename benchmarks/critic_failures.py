@@ -32,11 +32,9 @@ critic is re-judged without simulating again).
 from __future__ import annotations
 
 import argparse
-import gzip
 import hashlib
 import json
 import os
-import pickle
 import time
 from collections.abc import Iterable
 from concurrent.futures import ProcessPoolExecutor
@@ -47,6 +45,7 @@ os.environ.setdefault("LP_NUM_THREADS", "1")  # one rasteriser thread: a worker 
 
 import numpy as np  # noqa: E402
 
+from obs_cache import cached  # noqa: E402
 from vcage.backends import BackendConfig  # noqa: E402
 from vcage.critics import Critic, CriticConfig, Observation, Verdict, make_critic  # noqa: E402
 from vcage.critics.base import View  # noqa: E402
@@ -142,15 +141,7 @@ def rollout(goal: str, index: int, seed: int, fault: str | None) -> Sample | str
 def _job(job: tuple[str, int, int, str | None, str | None]) -> Sample | str:
     goal, index, seed, fault, cache = job
     path = Path(cache) / f"{goal}-{index}-{seed}-{fault or 'none'}.pkl.gz" if cache else None
-    if path is not None and path.is_file():
-        with gzip.open(path, "rb") as f:
-            return pickle.load(f)  # noqa: S301 - our own cache
-    out = rollout(goal, index, seed, fault)
-    if path is not None:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        with gzip.open(path, "wb", compresslevel=3) as f:
-            pickle.dump(out, f)
-    return out
+    return cached(path, lambda: rollout(goal, index, seed, fault))
 
 
 def jobs(goals: Iterable[str], seeds: int, faults_per_seed: int, cache: str | None, first_seed: int = 0
