@@ -125,3 +125,47 @@ def test_an_object_that_already_stood_tipped_is_not_upright() -> None:
     on_block = _world(block, ObjectSpec("bell", "bell", (0.55, 0.05), z=0.8))
     accept, reason, upright = judge(before, on_block)
     assert upright and accept, reason
+
+
+def _judge_typed(before: World, after: World, subtask: Subtask) -> tuple[bool, str, dict[str, bool]]:
+    """The critic's verdict (with the plan's types, as in a run) and the oracle's."""
+    types = {n: after.object(n).type_name for n in after.object_names}
+    obs = Observation(subtask=subtask, labels=tuple(after.object_names), before=_views(before),
+                      after=_views(after), types=types)
+    verdict = CRITIC.judge(obs)
+    return verdict.accept, verdict.reason, Oracle().check(after, subtask.predicates)
+
+
+def test_a_mouse_on_a_phone_lying_on_the_pad_is_not_on_the_pad() -> None:
+    """Vanilla left phones lying flat on the pad, and put the mouse on one: held up by the phone
+    (1.1 cm) over most of its outline, it does not touch the pad (the oracle: not on it), though
+    its top stands no higher than the thin pad's tolerance allows. Beside the phone it is on the pad."""
+    pad = ObjectSpec("pad", "mouse_pad", (0.55, 0.1))
+    phone = ObjectSpec("phone", "phone", (0.55, 0.1), yaw=np.pi / 2, z=0.757)
+    sub = put_on("mouse", "pad", "the mouse is on the pad")
+    before = _world(ObjectSpec("mouse", "mouse", (0.45, -0.15)), pad, phone)
+    on_phone = _world(ObjectSpec("mouse", "mouse", (0.55, 0.1), z=0.77), pad, phone)
+    accept, reason, oracle = _judge_typed(before, on_phone, sub)
+    assert not oracle["on(mouse, pad)"]
+    assert not accept and "mouse lies over phone" in reason, reason
+    moved = ObjectSpec("phone", "phone", (0.55, 0.155), yaw=np.pi / 2, z=0.757)
+    beside = _world(ObjectSpec("mouse", "mouse", (0.55, 0.07), z=0.76), pad, moved)
+    accept, reason, oracle = _judge_typed(_world(ObjectSpec("mouse", "mouse", (0.45, -0.15)), pad, moved),
+                                          beside, sub)
+    assert oracle["on(mouse, pad)"] and accept, reason
+
+
+def test_a_cup_standing_on_a_stand_over_its_coaster_is_not_on_it() -> None:
+    """Seen from above, a cup shows its floor inside its rim: its top is the rim, at its outline.
+    Standing on a stand over the coaster (one the top view did not show before, so nothing there
+    says what holds the cup up), the cup's rim is a stand higher than a cup on the coaster reaches,
+    though its floor (what the inside of its outline shows) is not (a Vanilla rollout left a cup on
+    a basket turned over the coaster)."""
+    coaster = ObjectSpec("coaster", "coaster", (0.55, 0.1))
+    sub = put_on("cup", "coaster", "the cup is on the coaster")
+    before = _world(ObjectSpec("cup", "cup", (0.45, -0.15)), coaster)
+    stand = ObjectSpec("stand", "object_stand", (0.55, 0.1), z=0.756)
+    on_stand = _world(ObjectSpec("cup", "cup", (0.55, 0.1), z=0.81), coaster, stand)
+    accept, reason, oracle = _judge_typed(before, on_stand, sub)
+    assert not oracle["on(cup, coaster)"]
+    assert not accept and "higher than cup standing on coaster's surface reaches" in reason, reason

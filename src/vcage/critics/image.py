@@ -111,6 +111,11 @@ HEIGHT_RATIO = 0.8  # highest point (front view without depth: height) after / b
 # high was seen accepted on a Vanilla rollout), and the top-view pixels of ``a`` that must lie over
 # the other object
 SUPPORT_TOL = 0.02
+# A flat object (a phone, a stamp mat: 1.1 and 0.5-0.7 cm) that stood under most of ``a``'s outline
+# (:data:`MIN_OVERLAP`) holds ``a`` up if its top stood this far (metres) above the surface: the
+# oracle's ``on`` wants ``a`` to touch ``b``. Under only part of the outline, an object this low may
+# lie beside ``a``'s base (a bell's rim under a cup's side), so there it takes :data:`SUPPORT_TOL`.
+THIN_SUPPORT = 0.005
 HEIGHT_TOL = 0.01
 TOP_TOL = 0.01
 # Metres under a container's rim below which an object's underside lies in it: loaves lying level
@@ -296,8 +301,9 @@ def _landed_on_other(obs: Observation, top: View, a: str, b: str, inside: bool) 
       takes the place of its height above the rim.
     - ``a`` rests on ``b``'s rim (see :func:`_on_rim`).
     - ``a`` lies over another object ``c`` whose top stood more than :data:`SUPPORT_TOL` above that
-      surface: before the subtask the top view showed ``c`` where ``a`` is seen now, and ``c`` is
-      still there (followed if it was pushed), so ``a`` lies above ``c`` and cannot be down on ``b``.
+      surface (:data:`THIN_SUPPORT` under most of ``a``'s outline): before the subtask the top view
+      showed ``c`` where ``a`` is seen now, and ``c`` is still there (followed if it was pushed), so
+      ``a`` lies above ``c`` and cannot be down on ``b``.
       Not asked of ``a`` leaning in ``b``: it may lean against ``c`` standing in ``b`` (a loaf on
       a cup that stood in the basket, its lower end on the floor); its lower end decides.
     """
@@ -360,10 +366,8 @@ def _on_rim(obs: Observation, top: View, a: str, b: str,
 def _own_height(obs: Observation, a: str, outline: bool = False) -> float | None:
     """``a``'s own height: its highest point before the subtask, where the top view (with depth) saw
     it standing on the table (the ring of pixels around it at the table's height); None if it did not
-    (it stood on something, or nothing around it shows). ``outline``: its outline's pixels (their
-    median) count too: an open container's highest point is its rim, one or two pixels wide at its
-    outline, around a floor seen from above (a silhouette pixel's depth alone may be far off, see
-    :func:`_inner`)."""
+    (it stood on something, or nothing around it shows). ``outline``: its outline's pixels count too
+    (an open container's rim, see :func:`_highest`)."""
     before = obs.before.get(TOP)
     hb = _heights(before) if before is not None else None
     if before is None or hb is None:
@@ -372,9 +376,7 @@ def _own_height(obs: Observation, a: str, outline: bool = False) -> float | None
     ring = dilate(was, 2) & ~dilate(was, 1) & (before.segmentation == -1)
     if not was.any() or ring.sum() < UNDER_PX or float(np.median(hb[ring])) > HEIGHT_TOL:
         return None
-    own = _highest(hb, was)
-    edge = was & dilate(~was, 1)
-    return max(own, float(np.median(hb[edge]))) if outline and edge.any() else own
+    return _highest(hb, was, rim=outline)
 
 
 def _on_its_side(obs: Observation, top: View, a: str, b: str) -> str | None:
@@ -441,7 +443,7 @@ def _not_down(obs: Observation, top: View, a: str, surface: float | None, floor:
         above = float(ha[ma].min()) - height - surface
         if above > HEIGHT_TOL:
             return f"{a} stands {100 * above:.1f} cm higher than resting on {where} allows"
-        taller = _highest(ha, ma) - height - surface
+        taller = _highest(ha, ma, rim=_open(_type_of(obs, a))) - height - surface
         if standing and taller > TOP_TOL:
             too_tall = f"{a}'s top is {100 * taller:.1f} cm higher than {a} standing on {where} reaches"
     surface = floor if surface is None else surface
@@ -457,7 +459,7 @@ def _not_down(obs: Observation, top: View, a: str, surface: float | None, floor:
         if under.sum() < UNDER_PX:
             continue
         rise = float(np.median(shift(np.where(was, hb, 0.0), dr, dc)[under])) - surface
-        if rise > SUPPORT_TOL:
+        if rise > SUPPORT_TOL or (rise > THIN_SUPPORT and under.sum() >= MIN_OVERLAP * ma.sum()):
             return f"{a} lies over {c}, whose top is {100 * rise:.1f} cm above {where}"
     return too_tall
 
@@ -501,8 +503,7 @@ def _turned_over(obs: Observation, top: View, a: str) -> str | None:
     around them."""
     otype = _type_of(obs, a)
     before = obs.before.get(TOP)
-    if (otype is None or before is None or before.pixel_size is None
-            or any(p.kind == "in" for p in otype.placements)):
+    if otype is None or before is None or before.pixel_size is None or _open(otype):
         return None
     mask = _mask(obs, before, a)
     if not _on_its_base(otype, before, mask):
@@ -682,10 +683,21 @@ def _heights(view: View) -> np.ndarray | None:
     return float(np.median(view.depth[view.segmentation == -1])) - view.depth
 
 
-def _highest(heights: np.ndarray, mask: np.ndarray) -> float:
+def _highest(heights: np.ndarray, mask: np.ndarray, rim: bool = False) -> float:
     """The highest point of ``mask`` in a top view's ``heights``, read inside its outline (see
-    :func:`_inner`) at the 95th percentile, so that a few stray pixels do not set it."""
-    return float(np.percentile(heights[_inner(mask)], 95))
+    :func:`_inner`) at the 95th percentile, so that a few stray pixels do not set it. ``rim``: the
+    outline's pixels (their median) count too: an open container's highest point is its rim, one or
+    two pixels wide at its outline, around a floor seen from above (a silhouette pixel's depth alone
+    may be far off)."""
+    high = float(np.percentile(heights[_inner(mask)], 95))
+    edge = mask & dilate(~mask, 1)
+    return max(high, float(np.median(heights[edge]))) if rim and edge.any() else high
+
+
+def _open(otype: ObjectType | None) -> bool:
+    """Whether objects of type ``otype`` hold things inside them (a cup, a basket: seen from above,
+    their inside shows)."""
+    return otype is not None and any(p.kind == "in" for p in otype.placements)
 
 
 def _inner(mask: np.ndarray) -> np.ndarray:
@@ -882,7 +894,7 @@ def _off_height(obs: Observation, top: View, x: str, high: float) -> str | None:
     button on a dome is too few pixels for the top view's highest reading.) Containers are left
     out: from the top a hollow one shows its inside."""
     otype = _type_of(obs, x)
-    if otype is None or any(p.kind == "in" for p in otype.placements):
+    if otype is None or _open(otype):
         return None
     if high > otype.size[2] * otype.scale_range[1] + UPRIGHT_TOL \
             and _not_down(obs, top, x, None, 0.0, "the table", (x,)) is None:
