@@ -56,7 +56,7 @@ _predicate("on_table", 1, 1, "the object rests on the table top itself, not on a
 _predicate("upright", 1, 1, "the object stands in its upright orientation (not tipped over)")
 _predicate("lifted", 1, 1, "the object is held at least 5 cm above the table")
 _predicate("released", 1, 1, "the hand no longer holds the object")
-_predicate("pressed", 1, 1, "the object's button or lever was pressed during the subtask", Kind.EVENT)
+_predicate("pressed", 1, 1, "the robot pressed the object's button or lever during the subtask", Kind.EVENT)
 _predicate("opened", 1, 1, "the object's drawer is pulled out at least as far as counts as open")
 _predicate("closed", 1, 1, "the object's drawer is pushed shut")
 _predicate("hanging", 2, 2, "the first object hangs from the second (on its hook), clear of the table")

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from vcage.assets.catalog import CATALOG
 from vcage.planning.schema import Predicate
 from vcage.scene.compose import compose
 from vcage.scene.spec import ObjectSpec, SceneSpec
@@ -17,7 +18,7 @@ from vcage.skills.base import Skills
 from vcage.skills.faults import FaultConfig, FaultInjector
 from vcage.skills.placements import placement_frame
 from vcage.tasks.oracle import Oracle
-from vcage.tasks.predicates import ORACLE_CHECKS
+from vcage.tasks.predicates import ORACLE_CHECKS, joint_displacement
 
 PRESSED = Predicate(name="pressed", args=("bell",))
 
@@ -69,6 +70,26 @@ def test_a_light_press_a_hover_and_a_press_before_watching_do_not_count() -> Non
     skills.do("retreat")
     assert oracle.check(world, [PRESSED]) == {"pressed(bell)": False}
     assert Oracle().check(world, [PRESSED]) == {"pressed(bell)": False}  # never watched
+
+
+def test_a_button_held_down_by_a_loaf_lying_on_it_is_not_pressed_by_the_robot() -> None:
+    """Vanilla put loaves on bells: the loaf's weight holds the button down its travel, and the hand
+    pressing the bell meets the loaf, not the bell. The button went down, but the robot did not
+    press the bell; pressed straight, the same bell is."""
+    scene = (ObjectSpec("bell", "bell", (0.55, 0.05)), ObjectSpec("bread", "bread", (0.55, 0.05), z=0.83))
+    world = _settled(*scene)
+    button = CATALOG.get("bell").functional_point(None)
+    assert joint_displacement(world, "bell", button.joint) >= button.travel  # held down at rest
+    assert not _value(world, "pressed", "bell")
+    skills = Skills(world)
+    oracle = _watched(skills)
+    skills.do("press", obj="bell")
+    assert oracle.check(world, [PRESSED]) == {"pressed(bell)": False}
+    world = _settled(scene[0])
+    skills = Skills(world)
+    oracle = _watched(skills)
+    skills.do("press", obj="bell")
+    assert oracle.check(world, [PRESSED]) == {"pressed(bell)": True}
 
 
 def test_inside_needs_the_region_and_the_height_below_the_rim() -> None:

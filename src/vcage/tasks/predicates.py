@@ -152,13 +152,26 @@ def joint_displacement(world: World, obj: str, joint: str) -> float:
 
 
 def pressed(world: World, obj: str, point: str | None = None) -> bool:
-    """The functional point's joint is displaced by at least its annotated travel."""
+    """The robot presses ``obj``: the functional point's joint is displaced by at least its annotated
+    travel while the robot touches ``obj``. Not a button pushed down by something else (a loaf that
+    lay on a bell, pressed by the hand; the table under a bell that fell on its top)."""
     inst = world.object(obj)
     fp = CATALOG.get(inst.type_name).functional_point(point)
     if fp.joint is None:
         return False
     travel = fp.travel * (inst.scale if fp.kind in ("button",) else 1.0)
-    return joint_displacement(world, obj, fp.joint) >= travel
+    return joint_displacement(world, obj, fp.joint) >= travel and robot_touches(world, obj)
+
+
+def robot_touches(world: World, obj: str) -> bool:
+    """Some geom of the robot touches ``obj``."""
+    d = world.data
+    if d.ncon == 0:
+        return False
+    g1, g2 = d.contact.geom1[: d.ncon], d.contact.geom2[: d.ncon]
+    idx = world.object_names.index(obj)
+    return bool(np.any((world.geom_is_robot(g1) & (world.object_of_geom(g2) == idx))
+                       | (world.geom_is_robot(g2) & (world.object_of_geom(g1) == idx))))
 
 
 def _drawer_out(world: World, obj: str, point: str | None) -> tuple[float, float] | None:
