@@ -22,7 +22,8 @@ is the simplified meshes, as in a run).
 
 ``--cache DIR`` stores every judged subtask's observation and the oracle's verdict (and re-uses
 them on the next run, so a changed critic is re-judged in seconds without simulating again; a
-change to anything else, skills or physics, needs a fresh directory).
+directory filled by code that has changed outside ``vcage/critics`` since is refused, see
+``obs_cache.py``).
 """
 
 from __future__ import annotations
@@ -37,7 +38,7 @@ from pathlib import Path
 
 os.environ.setdefault("LP_NUM_THREADS", "1")  # one rasteriser thread: a worker is one core
 
-from obs_cache import cached  # noqa: E402
+from obs_cache import cached, open_cache  # noqa: E402
 from vcage.config import MESH_DETAILS, RenderConfig  # noqa: E402
 from vcage.critics import Critic, CriticConfig, Observation, Verdict, make_critic  # noqa: E402
 from vcage.pipeline.config import GenerateConfig  # noqa: E402
@@ -122,7 +123,8 @@ def main() -> None:
     parser.add_argument("--cache", default=None, help="directory for the judged subtasks' observations")
     args = parser.parse_args()
     seeds = range(args.first_seed, args.first_seed + args.seeds)
-    jobs = [(g, s, args.mesh_detail, args.cache) for g in args.goals for s in seeds]
+    cache = open_cache(args.cache)
+    jobs = [(g, s, args.mesh_detail, str(cache) if cache else None) for g in args.goals for s in seeds]
     t0 = time.perf_counter()
     with ProcessPoolExecutor(args.workers) as pool:
         pairs = [p for rows in pool.map(_run, jobs) for p in rows]

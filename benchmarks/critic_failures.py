@@ -26,7 +26,8 @@ against a real model can be re-printed (and audited answer by answer) without it
         --cache DIR --vlm-tape vlm.jsonl --vlm-record
 
 ``--cache DIR`` stores every sample's observation (and re-uses it on the next run, so a changed
-critic is re-judged without simulating again).
+critic is re-judged without simulating again; a directory filled by code that has changed outside
+``vcage/critics`` since is refused, see ``obs_cache.py``).
 """
 
 from __future__ import annotations
@@ -45,7 +46,7 @@ os.environ.setdefault("LP_NUM_THREADS", "1")  # one rasteriser thread: a worker 
 
 import numpy as np  # noqa: E402
 
-from obs_cache import cached  # noqa: E402
+from obs_cache import cached, open_cache  # noqa: E402
 from vcage.backends import BackendConfig  # noqa: E402
 from vcage.critics import Critic, CriticConfig, Observation, Verdict, make_critic  # noqa: E402
 from vcage.critics.base import View  # noqa: E402
@@ -222,7 +223,8 @@ def main() -> None:
     args = parser.parse_args()
     if args.vlm_record and not args.vlm_tape:
         parser.error("--vlm-record needs --vlm-tape FILE")
-    todo = jobs(args.goals, args.seeds, args.faults_per_seed, args.cache, args.first_seed)
+    cache = open_cache(args.cache)
+    todo = jobs(args.goals, args.seeds, args.faults_per_seed, str(cache) if cache else None, args.first_seed)
     t0 = time.perf_counter()
     with ProcessPoolExecutor(args.workers) as pool:
         results = list(pool.map(_job, todo))

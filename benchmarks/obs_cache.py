@@ -1,20 +1,63 @@
 """A directory of pickled results that the critic benchmarks keep between runs.
 
 A rollout's observations do not depend on the critic that judges them, so a benchmark that stores
-them re-judges a changed critic in seconds. Each entry is written to a temporary file and renamed
-into place: a run stopped or failing mid-write leaves no truncated entry for the next run to trip on.
+them re-judges a changed critic in seconds. They do depend on everything else (the oracle's labels,
+the skills, the physics, the renderer), so a directory is stamped with a fingerprint of the package
+outside ``vcage/critics`` when first filled, and refused by code with another fingerprint: stale
+rollouts never pass for fresh ones. Each entry is written to a temporary file and renamed into
+place: a run stopped or failing mid-write leaves no truncated entry for the next run to trip on.
 """
 
 from __future__ import annotations
 
 import gzip
+import hashlib
 import os
 import pickle
 from collections.abc import Callable
 from pathlib import Path
 from typing import TypeVar
 
+import vcage
+
 T = TypeVar("T")
+STAMP = "SOURCE"  # the file in a cache directory that holds its fingerprint
+
+
+class StaleCache(SystemExit):
+    """The cache directory was filled by other code than this checkout's."""
+
+
+def fingerprint(root: Path | None = None) -> str:
+    """A digest of the package's files outside ``critics/`` (what a stored rollout depends on)."""
+    root = Path(vcage.__file__).parent if root is None else root
+    digest = hashlib.sha256()
+    for path in sorted(p for p in root.rglob("*") if p.is_file()):
+        rel = path.relative_to(root)
+        if rel.parts[0] == "critics" or "__pycache__" in rel.parts:
+            continue
+        digest.update(str(rel).encode() + b"\0" + path.read_bytes())
+    return digest.hexdigest()[:16]
+
+
+def open_cache(directory: str | None, source: str | None = None) -> Path | None:
+    """``directory``, created and stamped with ``source`` (default: this checkout's
+    :func:`fingerprint`) if new; :class:`StaleCache` if it holds entries of other code."""
+    if directory is None:
+        return None
+    path, source = Path(directory), source or fingerprint()
+    path.mkdir(parents=True, exist_ok=True)
+    stamp = path / STAMP
+    if stamp.is_file():
+        if stamp.read_text().strip() != source:
+            raise StaleCache(f"{path} holds rollouts made by other code than this checkout's (it changed "
+                             "outside vcage/critics since): give --cache a fresh directory")
+    elif any(path.iterdir()):
+        raise StaleCache(f"{path} holds files but no {STAMP} stamp saying which code made them: give "
+                         "--cache a fresh directory")
+    else:
+        stamp.write_text(source + "\n")
+    return path
 
 
 def cached(path: Path | None, make: Callable[[], T]) -> T:
