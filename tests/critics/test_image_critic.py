@@ -169,3 +169,27 @@ def test_a_cup_standing_on_a_stand_over_its_coaster_is_not_on_it() -> None:
     accept, reason, oracle = _judge_typed(before, on_stand, sub)
     assert not oracle["on(cup, coaster)"]
     assert not accept and "higher than cup standing on coaster's surface reaches" in reason, reason
+
+
+def test_a_phone_standing_on_its_edge_in_the_stand_is_not_on_it() -> None:
+    """On the stand's ramp a phone lies tilted with it, its top its width times the ramp's sine
+    above the slot; Vanilla left phones standing on an edge in the slot (the oracle: not on it),
+    their tops several centimetres higher. Lying on the ramp, as the skill puts it, it is on it."""
+    stand = ObjectSpec("stand", "phone_stand", (0.55, 0.1))
+    sub = put_on("phone", "stand", "the phone is on its stand")
+    before = _world(ObjectSpec("phone", "phone", (0.45, -0.15)), stand)
+
+    def set_in_slot(turn: float) -> World:
+        phone = ObjectSpec("phone", "phone", (0.57, 0.1), z=0.84)
+        world = compose(SceneSpec(objects=(phone, stand))).make_world()
+        adr = int(world.model.jnt_qposadr[world.model.joint("phone/free").id])
+        world.data.qpos[adr + 3:adr + 7] = [np.cos(turn / 2), np.sin(turn / 2), 0.0, 0.0]  # about its x axis
+        world.forward()
+        world.settle(0.8)
+        return world
+
+    accept, reason, oracle = _judge_typed(before, set_in_slot(1.5), sub)  # on its long edge
+    assert not oracle["on(phone, stand)"]
+    assert not accept and "higher than phone standing on stand's surface reaches" in reason, reason
+    accept, reason, oracle = _judge_typed(before, set_in_slot(0.35), sub)  # down on the ramp
+    assert oracle["on(phone, stand)"] and accept, reason

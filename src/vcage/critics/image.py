@@ -317,7 +317,7 @@ def _landed_on_other(obs: Observation, top: View, a: str, b: str, inside: bool) 
     rim = float(hb[_inner(mb)].max())
     surface = rim if inside else _surface(obs, b, rim)
     btype = _type_of(obs, b)
-    leans = btype is not None and bool(btype.placements) and btype.placements[0].slope > 0
+    slope = btype.placements[0].slope if btype is not None and btype.placements and not inside else 0.0
     ma = _mask(obs, top, a)
     was, now = int(_mask(obs, before, a).sum()), int(ma.sum())
     turned = was > 0 and not AREA_RATIO[0] <= now / was <= AREA_RATIO[1]
@@ -327,7 +327,7 @@ def _landed_on_other(obs: Observation, top: View, a: str, b: str, inside: bool) 
     # leaning, ``a`` may rest against what stands in ``b``: its lower end decides (``on_rim``)
     skip = tuple(obs.labels) if leaning else (a, b)
     return on_rim or _not_down(obs, top, a, surface, rim, f"{b}'s {'rim' if inside else 'surface'}",
-                               skip, standing=not leans, any_way_up=inside and (turned or leaning))
+                               skip, standing=True, any_way_up=inside and (turned or leaning), slope=slope)
 
 
 def _on_rim(obs: Observation, top: View, a: str, b: str,
@@ -424,20 +424,22 @@ def _standing_and_lying(obs: Observation, otype: ObjectType, before: View, a: st
 
 
 def _not_down(obs: Observation, top: View, a: str, surface: float | None, floor: float, where: str,
-              skip: tuple[str, ...], standing: bool = False, any_way_up: bool = False) -> str | None:
+              skip: tuple[str, ...], standing: bool = False, any_way_up: bool = False,
+              slope: float = 0.0) -> str | None:
     """Why ``a`` cannot rest on a support whose surface lies ``surface`` above the table (``where``
     names it), from the top view's heights; None if they allow it (or cannot tell). Without a known
     surface only clutter higher than ``floor`` counts (see :func:`_landed_on_other`). ``standing``:
-    ``a`` stands there as it stood before (put down by the hand, on a surface that does not lean), so
-    its top can be no higher than its type's height above the surface either (tipped onto a side, or
-    propped on something, it stands taller). ``any_way_up``: ``a`` may rest on any face (in a
-    container), so its longest side bounds how far its top stands above the surface."""
+    ``a`` stands there as it stood before (put down by the hand), so its top can be no higher than
+    its type reaches above the surface either (tipped onto a side, or propped on something, it
+    stands taller). ``any_way_up``: ``a`` may rest on any face (in a container), so its longest side
+    bounds how far its top stands above the surface. ``slope``: the surface leans so far (radians),
+    and ``a`` with it (see :func:`_max_height`)."""
     before = obs.before.get(TOP)
     hb, ha = (_heights(before), _heights(top)) if before is not None else (None, None)
     ma = _mask(obs, top, a)
     if before is None or hb is None or ha is None or not ma.any():
         return None
-    height = _max_height(obs, a, any_way_up)
+    height = _max_height(obs, a, any_way_up, slope)
     too_tall = None  # said after the clutter under ``a``, which says more
     if surface is not None and height is not None:
         above = float(ha[ma].min()) - height - surface
@@ -554,13 +556,19 @@ def _surface(obs: Observation, b: str, top: float) -> float | None:
     return top - (otype.size[2] - otype.placements[0].pos[2]) * otype.scale_range[0]
 
 
-def _max_height(obs: Observation, a: str, any_way_up: bool = False) -> float | None:
-    """``a``'s height above its resting face at the largest scale of its type (``any_way_up``: above
-    whichever face it rests on, its longest side)."""
+def _max_height(obs: Observation, a: str, any_way_up: bool = False, slope: float = 0.0) -> float | None:
+    """How high ``a`` reaches above the point of its support's surface where it rests, at the largest
+    scale of its type: its height above its resting face (``any_way_up``: above whichever face it
+    rests on, its longest side); on a surface that leans by ``slope`` radians (a stand's ramp), its
+    base tilts with it, its longest side across rising up the ramp (a phone: 7.2 cm at the largest
+    scale on the stand's 0.35 rad; standing on its edge against something, 13.5 cm and more)."""
     otype = _type_of(obs, a)
     if otype is None:
         return None
-    return (max(otype.size) if any_way_up else otype.size[2]) * otype.scale_range[1]
+    if any_way_up:
+        return max(otype.size) * otype.scale_range[1]
+    across = max(otype.size[0], otype.size[1])
+    return (across * float(np.sin(slope)) + otype.size[2] * float(np.cos(slope))) * otype.scale_range[1]
 
 
 def _covered(obs: Observation, top: View, b: str) -> bool:
