@@ -14,15 +14,17 @@ simulator state. Each predicate is checked in image space:
   lowest pixel row lies within ``b``'s rows (for ``inside``, no lower than ``b``'s bottom). With the
   top view's depth, ``a`` is down on ``b``: its lowest point is no higher than its type's height
   above ``b``'s surface (for ``inside``, its rim), and it does not lie over another object that
-  stood higher than that surface before the subtask (clutter on the target); an object that stood on
+  stood higher than that surface before the subtask (clutter on the target; a flat one, such as a
+  phone lying on the target, where it lay under most of ``a``'s outline); an object that stood on
   its base with a curved top before and shows a flat one now, or a domed one that barely bends now,
   lies turned over, and one taller than wide whose top is now nearer its height lying on a side than
   its height standing (read before, on the table; where it did not stand there, the bounds its
   type's scales allow) lies on its side (neither asked in a container,
-  where it may lie any way up; the side is asked also where ``a`` hides ``b``). Put down on a surface
-  that does not lean, ``a``'s top stands no higher than its type's height above that surface (in a
-  container, where its top view shows it turned or its top slopes as a leaning object's does, its
-  longest side above the rim). In a container its underside, its own height (seen on the table
+  where it may lie any way up; the side is asked also where ``a`` hides ``b``). Put down, ``a``'s
+  top (an open container's: its rim, at its outline) stands no higher than its type's height above
+  that surface (on a surface that leans, a stand's ramp, its longest side across tilted with the
+  ramp; in a container, where its top view shows it turned or its top slopes as a leaning object's
+  does, its longest side above the rim). In a container its underside, its own height (seen on the table
   before) under its top, or under its top's lower end where it leans, lies below the rim (not
   resting on it). In a drawer (a placement that comes out with a joint) the drawer is still open
   after the subtask, and ``a`` lies over what came out of ``b`` (not on its body), below the
@@ -295,10 +297,10 @@ def _landed_on_other(obs: Observation, top: View, a: str, b: str, inside: bool) 
 
     - ``a`` stands too high: an object resting on ``b`` has the top of its own axis (whose height
       its lowest pixel cannot exceed) at most its height above its resting face, which lies on
-      ``b``'s surface. In ``b`` it may lie any way up (the oracle asks only that its lowest point be
-      below the rim): where its top-view area changed as a turned object's does (see
-      :data:`AREA_RATIO`), or its top slopes more than :data:`LEVEL` (it leans), its longest side
-      takes the place of its height above the rim.
+      ``b``'s surface (on a leaning surface, see :func:`_max_height`). In ``b`` it may lie any way
+      up (the oracle asks only that its lowest point be below the rim): where its top-view area
+      changed as a turned object's does (see :data:`AREA_RATIO`), or its top slopes more than
+      :data:`LEVEL` (it leans), its longest side takes the place of its height above the rim.
     - ``a`` rests on ``b``'s rim (see :func:`_on_rim`).
     - ``a`` lies over another object ``c`` whose top stood more than :data:`SUPPORT_TOL` above that
       surface (:data:`THIN_SUPPORT` under most of ``a``'s outline): before the subtask the top view
@@ -560,8 +562,8 @@ def _max_height(obs: Observation, a: str, any_way_up: bool = False, slope: float
     """How high ``a`` reaches above the point of its support's surface where it rests, at the largest
     scale of its type: its height above its resting face (``any_way_up``: above whichever face it
     rests on, its longest side); on a surface that leans by ``slope`` radians (a stand's ramp), its
-    base tilts with it, its longest side across rising up the ramp (a phone: 7.2 cm at the largest
-    scale on the stand's 0.35 rad; standing on its edge against something, 13.5 cm and more)."""
+    base tilts with it, its longest side across rising up the ramp (a phone: 6.2 cm at the largest
+    scale on the stand's 0.35 rad; standing on an edge in the slot, 6-8 cm and more)."""
     otype = _type_of(obs, a)
     if otype is None:
         return None
