@@ -37,6 +37,15 @@ def _judge(before: World, after: World, subtask):  # type: ignore[no-untyped-def
     return CRITIC.judge(obs), Oracle().check(after, subtask.predicates)
 
 
+def _judge_typed(before: World, after: World, subtask: Subtask) -> tuple[bool, str, dict[str, bool]]:
+    """The critic's verdict (with the plan's types, as in a run) and the oracle's."""
+    types = {n: after.object(n).type_name for n in after.object_names}
+    obs = Observation(subtask=subtask, labels=tuple(after.object_names), before=_views(before),
+                      after=_views(after), types=types)
+    verdict = CRITIC.judge(obs)
+    return verdict.accept, verdict.reason, Oracle().check(after, subtask.predicates)
+
+
 def test_object_on_its_target_is_accepted_like_the_oracle() -> None:
     start = _world(ObjectSpec("block", "block", (0.5, -0.15)), PAD)
     done = _world(ObjectSpec("block", "block", (0.58, 0.1), z=0.756), PAD)
@@ -103,12 +112,8 @@ def test_an_object_that_already_stood_tipped_is_not_upright() -> None:
     so only its height against its type's tells (a standing bell is at most 6.3 cm tall). A bell
     standing is accepted, and so is one standing on a block (what stands under it raises it)."""
     def judge(before: World, after: World) -> tuple[bool, str, bool]:
-        sub = _subtask(("upright", ("bell",)))
-        types = {n: after.object(n).type_name for n in after.object_names}
-        obs = Observation(subtask=sub, labels=tuple(after.object_names), before=_views(before),
-                          after=_views(after), types=types)
-        verdict = CRITIC.judge(obs)
-        return verdict.accept, verdict.reason, Oracle().check(after, sub.predicates)["upright(bell)"]
+        accept, reason, oracle = _judge_typed(before, after, _subtask(("upright", ("bell",))))
+        return accept, reason, oracle["upright(bell)"]
 
     lying = compose(SceneSpec(objects=(ObjectSpec("bell", "bell", (0.55, 0.05), z=0.8),))).make_world()
     adr = int(lying.model.jnt_qposadr[lying.model.joint("bell/free").id])
@@ -125,15 +130,6 @@ def test_an_object_that_already_stood_tipped_is_not_upright() -> None:
     on_block = _world(block, ObjectSpec("bell", "bell", (0.55, 0.05), z=0.8))
     accept, reason, upright = judge(before, on_block)
     assert upright and accept, reason
-
-
-def _judge_typed(before: World, after: World, subtask: Subtask) -> tuple[bool, str, dict[str, bool]]:
-    """The critic's verdict (with the plan's types, as in a run) and the oracle's."""
-    types = {n: after.object(n).type_name for n in after.object_names}
-    obs = Observation(subtask=subtask, labels=tuple(after.object_names), before=_views(before),
-                      after=_views(after), types=types)
-    verdict = CRITIC.judge(obs)
-    return verdict.accept, verdict.reason, Oracle().check(after, subtask.predicates)
 
 
 def test_a_mouse_on_a_phone_lying_on_the_pad_is_not_on_the_pad() -> None:
