@@ -151,6 +151,24 @@ def test_a_mouse_on_a_phone_lying_on_the_pad_is_not_on_the_pad() -> None:
     assert oracle["on(mouse, pad)"] and accept, reason
 
 
+def test_a_seal_on_a_coaster_lying_on_the_mat_is_not_on_the_mat() -> None:
+    """A coaster (5 mm, pressed 0.6 mm into the ink) lying on the stamp mat holds a seal put on it
+    off the mat: the oracle says not on it. Under the seal's whole outline, the coaster's top 4 mm
+    above the mat's surface says so (Vanilla left seals standing on a phone whose top was 3.3 mm
+    above the mat). Put on the mat beside the coaster, the seal is on it."""
+    mat = ObjectSpec("mat", "stamp_mat", (0.55, 0.1))
+    sub = put_on("seal", "mat", "the seal is on the mat")
+    away = ObjectSpec("seal", "seal", (0.45, -0.15))
+    for coaster, seal, on in ((ObjectSpec("coaster", "coaster", (0.55, 0.1), z=0.757),
+                               ObjectSpec("seal", "seal", (0.55, 0.1), z=0.763), False),
+                              (ObjectSpec("coaster", "coaster", (0.55, 0.24)),
+                               ObjectSpec("seal", "seal", (0.55, 0.09), z=0.757), True)):
+        accept, reason, oracle = _judge_typed(_world(away, mat, coaster), _world(seal, mat, coaster), sub)
+        assert oracle["on(seal, mat)"] is on
+        assert accept is on, reason
+        assert on or "seal lies over coaster" in reason, reason
+
+
 def test_a_cup_standing_on_a_stand_over_its_coaster_is_not_on_it() -> None:
     """Seen from above, a cup shows its floor inside its rim: its top is the rim, at its outline.
     Standing on a stand over the coaster (one the top view did not show before, so nothing there
