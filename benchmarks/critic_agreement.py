@@ -13,6 +13,13 @@ agreement, precision and recall of "accept" (as in ``vcage audit``), the share o
 failures the critic rejected (what keeps them out of a dataset) and balanced accuracy. A figure
 whose denominator is empty prints "n/a" (not 0%).
 
+Then the same figures split by how the rollout starts: with the plan's objects clear of every other
+object, or with one of them interpenetrating another deeper than 1 mm once the scene settled (the
+bound of V-CAGE's scene check; objects resting on one another in a settled scene sink 0.1-0.55 mm).
+Naive placement leaves many objects fused into each other (a seal sunk into a phone, a cup into a
+bell), and a fused pair moves as one; there the oracle's contact-based verdict reads a state no
+physical scene has, and V-CAGE's checked scenes never start so. The overall figure counts both.
+
     LP_NUM_THREADS=1 .venv/bin/python benchmarks/critic_agreement.py --seeds 10 --workers 2
 
 ``--first-seed K`` starts at episode K, for a sample that no threshold was chosen on.
@@ -20,10 +27,10 @@ whose denominator is empty prints "n/a" (not 0%).
 ``--mesh-detail full`` renders the critic's views with the robot's meshes as shipped (the default
 is the simplified meshes, as in a run).
 
-``--cache DIR`` stores every judged subtask's observation and the oracle's verdict (and re-uses
-them on the next run, so a changed critic is re-judged in seconds without simulating again; a
-directory filled by code that has changed outside ``vcage/critics`` since is refused, see
-``obs_cache.py``).
+``--cache DIR`` stores every judged subtask's observation and the oracle's verdict, and how the
+rollout started (re-used on the next run, so a changed critic is re-judged in seconds without
+simulating again; a directory filled by code that has changed outside ``vcage/critics`` since, or
+holding entries of an earlier form, is refused, see ``obs_cache.py``).
 """
 
 from __future__ import annotations
@@ -38,13 +45,15 @@ from pathlib import Path
 
 os.environ.setdefault("LP_NUM_THREADS", "1")  # one rasteriser thread: a worker is one core
 
-from obs_cache import cached, open_cache  # noqa: E402
+from obs_cache import cached, fingerprint, open_cache  # noqa: E402
 from vcage.config import MESH_DETAILS, RenderConfig  # noqa: E402
 from vcage.critics import Critic, CriticConfig, Observation, Verdict, make_critic  # noqa: E402
 from vcage.pipeline.config import GenerateConfig  # noqa: E402
-from vcage.pipeline.episode import attempt  # noqa: E402
+from vcage.pipeline.episode import Attempt, attempt  # noqa: E402
 from vcage.planning import make_planner  # noqa: E402
 from vcage.planning.goals import GOALS  # noqa: E402
+from vcage.planning.schema import Plan  # noqa: E402
+from vcage.scene.stability import StabilityConfig, penetrations  # noqa: E402
 
 DEFAULT_GOALS = ("get_ready_for_work", "prepare_breakfast", "tidy_the_desk", "set_the_table",
                  "build_a_tower", "sort_blocks_by_colour")
@@ -63,10 +72,26 @@ class Shadow(Critic):
 
 
 Judged = tuple[str, Observation, bool, str, str]  # scene, observation, oracle success, where, oracle
-Row = tuple[str, str, bool, bool, str]  # goal, scene, critic accepts, oracle success, why
+Episode = tuple[float, list[Judged]]  # how deep the plan's objects interpenetrate at the start (m), judged
+Row = tuple[str, str, bool, bool, str, bool]  # goal, scene, critic accepts, oracle success, why, fused
+FUSED = StabilityConfig().penetration  # deeper than this counts as interpenetration (the scene check's bound)
+ENTRIES = "episode-v2"  # what a cache entry holds (:data:`Episode`); part of the cache's stamp
 
 
-def _rollout(goal: str, episode: int, mesh_detail: str) -> list[Judged]:
+def _start_depth(result: Attempt, plan: Plan) -> float:
+    """How deep (metres) one of ``plan``'s objects interpenetrates another object where the rollout
+    started (the scene placed and settled; Vanilla checks nothing before it), 0.0 where none does."""
+    world, state = result.world, result.initial_state
+    if world is None or state is None:
+        return 0.0
+    world.set_state(state)
+    world.forward()
+    named, objects = {n for s in plan.subtasks for n in s.objects()}, set(world.object_names)
+    return max((d for a, b, d in penetrations(world, 0.0)
+                if a in objects and b in objects and (a in named or b in named)), default=0.0)
+
+
+def _rollout(goal: str, episode: int, mesh_detail: str) -> Episode:
     phrase = next(g for g in GOALS if g.name == goal).phrasings[0]
     plan = make_planner("offline").plan(phrase)
     # episode k: the seed of the Vanilla run's episode k
@@ -74,23 +99,26 @@ def _rollout(goal: str, episode: int, mesh_detail: str) -> list[Judged]:
     shadow = Shadow(make_critic(CriticConfig("image")).needs_views)
     result = attempt(plan, cfg.episode_seed(episode, 0), cfg, shadow)
     if result.rollout is None:
-        return []
+        return 0.0, []
     scene = hashlib.sha1(json.dumps(result.scene.to_dict() if result.scene else None, sort_keys=True,
                                     default=str).encode()).hexdigest()[:12]
     judged = [o for o in result.rollout.outcomes if o.verdict is not None]
-    return [(scene, obs, o.oracle_success, f"seed {episode} subtask {o.index + 1}", str(o.oracle))
-            for o, obs in zip(judged, shadow.seen, strict=True)]
+    return _start_depth(result, plan), [
+        (scene, obs, o.oracle_success, f"seed {episode} subtask {o.index + 1}", str(o.oracle))
+        for o, obs in zip(judged, shadow.seen, strict=True)]
 
 
 def _run(job: tuple[str, int, str, str | None]) -> list[Row]:
     goal, episode, mesh_detail, cache = job
     path = Path(cache) / f"{goal}-{episode}-{mesh_detail}.pkl.gz" if cache else None
-    judged = cached(path, lambda: _rollout(goal, episode, mesh_detail))
+    depth, judged = cached(path, lambda: _rollout(goal, episode, mesh_detail))
     critic = make_critic(CriticConfig("image"))
+    start = f" (starts interpenetrating: {1000 * depth:.1f} mm)" if depth > FUSED else ""
     rows: list[Row] = []
     for scene, obs, success, where, oracle in judged:
         verdict = critic.judge(obs)
-        rows.append((goal, scene, verdict.accept, success, f"{where}: {verdict.reason}; oracle {oracle}"))
+        why = f"{where}{start}: {verdict.reason}; oracle {oracle}"
+        rows.append((goal, scene, verdict.accept, success, why, depth > FUSED))
     return rows
 
 
@@ -99,10 +127,10 @@ def _pct(num: int, den: int, width: int = 7) -> str:
 
 
 def _line(name: str, pairs: list[Row]) -> str:
-    tp = sum(c and o for _, _, c, o, _ in pairs)
-    fp = sum(c and not o for _, _, c, o, _ in pairs)
-    fn = sum(not c and o for _, _, c, o, _ in pairs)
-    tn = sum(not c and not o for _, _, c, o, _ in pairs)
+    tp = sum(c and o for _, _, c, o, *_ in pairs)
+    fp = sum(c and not o for _, _, c, o, *_ in pairs)
+    fn = sum(not c and o for _, _, c, o, *_ in pairs)
+    tn = sum(not c and not o for _, _, c, o, *_ in pairs)
     n, scenes = len(pairs), len({(g, s) for g, s, *_ in pairs})
     bal = f"{(tp / (tp + fn) + tn / (tn + fp)) / 2:8.1%}" if tp + fn and tn + fp else f"{'n/a':>8s}"
     return (f"{name:24s} {n:6d} {tp + fn:5d} {tn + fp:5d} {scenes:6d} {_pct(tp + tn, n)} {_pct(tp, tp + fp)} "
@@ -123,7 +151,7 @@ def main() -> None:
     parser.add_argument("--cache", default=None, help="directory for the judged subtasks' observations")
     args = parser.parse_args()
     seeds = range(args.first_seed, args.first_seed + args.seeds)
-    cache = open_cache(args.cache)
+    cache = open_cache(args.cache, f"{fingerprint()} {ENTRIES}")
     jobs = [(g, s, args.mesh_detail, str(cache) if cache else None) for g in args.goals for s in seeds]
     t0 = time.perf_counter()
     with ProcessPoolExecutor(args.workers) as pool:
@@ -137,11 +165,15 @@ def main() -> None:
     for goal in args.goals:
         print(_line(goal, [p for p in pairs if p[0] == goal]))
     print(_line("overall", pairs))
+    print(f"\nby how the rollout starts (one of the plan's objects interpenetrating another deeper than "
+          f"{1000 * FUSED:.0f} mm once the scene settled):")
+    print(_line("clear at the start", [p for p in pairs if not p[5]]))
+    print(_line("interpenetrating", [p for p in pairs if p[5]]))
     print("\nsucc/fail: judged subtasks the oracle says succeeded / failed; scenes: distinct scenes they "
           "come from; prec/recall: of the critic's accepts; caught: share of the oracle's failures the "
           "critic rejected; bal.acc: mean of recall and caught; n/a: empty denominator")
     if args.show_errors:
-        for goal, _, accept, success, why in pairs:
+        for goal, _, accept, success, why, _ in pairs:
             if accept != success:
                 print(f"  {'false accept' if accept else 'false reject'} {goal} {why}")
 

@@ -51,7 +51,8 @@ def open_cache(directory: str | None, source: str | None = None) -> Path | None:
     if stamp.is_file():
         if stamp.read_text().strip() != source:
             raise StaleCache(f"{path} holds rollouts made by other code than this checkout's (it changed "
-                             "outside vcage/critics since): give --cache a fresh directory")
+                             "outside vcage/critics since, or the benchmark's entries changed form): give "
+                             "--cache a fresh directory")
     elif any(path.iterdir()):
         raise StaleCache(f"{path} holds files but no {STAMP} stamp saying which code made them: give "
                          "--cache a fresh directory")

@@ -1,6 +1,7 @@
 """``benchmarks/critic_agreement.py --cache``: Vanilla rollouts are stored once and re-judged from the
 store (a changed critic is measured in seconds); an entry is written whole or not at all, and a
-store filled by other code than the checkout's (outside ``vcage/critics``) is refused."""
+store filled by other code than the checkout's (outside ``vcage/critics``) is refused. The table is
+split by how deep the plan's objects interpenetrate where the rollout starts."""
 
 from __future__ import annotations
 
@@ -16,7 +17,13 @@ import pytest
 BENCHMARKS = Path(__file__).resolve().parents[2] / "benchmarks"
 sys.path.insert(0, str(BENCHMARKS))
 
+from critic_agreement import FUSED, _start_depth  # noqa: E402
 from obs_cache import STAMP, StaleCache, cached, fingerprint, open_cache  # noqa: E402
+from vcage.pipeline.episode import Attempt  # noqa: E402
+from vcage.pipeline.stage import Stage  # noqa: E402
+from vcage.planning import make_planner  # noqa: E402
+from vcage.scene.compose import compose  # noqa: E402
+from vcage.scene.spec import ObjectSpec, SceneSpec  # noqa: E402
 
 
 def _agreement(cache: Path) -> subprocess.CompletedProcess[str]:
@@ -39,17 +46,26 @@ def test_a_second_run_judges_the_stored_rollouts(tmp_path: Path) -> None:
     entry = cache / "build_a_tower-3-lod.pkl.gz"
     assert "build_a_tower                 3     2     1      1  100.0%" in first
     assert _run(cache) == first
+    assert "clear at the start            3     2     1      1  100.0%" in first
     # what is judged is what the store holds: an oracle verdict changed there changes the table
     with gzip.open(entry, "rb") as f:
-        judged = pickle.load(f)  # noqa: S301 - written by the run above
+        depth, judged = pickle.load(f)  # noqa: S301 - written by the run above
+    assert depth <= FUSED
     i = next(k for k, (*_, success, _, _) in enumerate(judged) if success)
     scene, obs, _, where, _ = judged[i]
     judged[i] = (scene, obs, False, where, "{'stored': False}")
     with gzip.open(entry, "wb") as f:
-        pickle.dump(judged, f)
+        pickle.dump((depth, judged), f)
     again = _run(cache)
     assert "build_a_tower                 3     1     2      1   66.7%" in again
     assert f"false accept build_a_tower {where}: " in again
+    # ... and so does the depth: stored deeper than the bound, the episode's subtasks change lines
+    with gzip.open(entry, "wb") as f:
+        pickle.dump((0.02, judged), f)
+    fused = _run(cache)
+    assert "clear at the start            0     0     0      0     n/a" in fused
+    assert "interpenetrating              3     1     2      1   66.7%" in fused
+    assert f"false accept build_a_tower {where} (starts interpenetrating: 20.0 mm): " in fused
 
 
 def test_an_entry_that_cannot_be_written_leaves_nothing_behind(tmp_path: Path) -> None:
@@ -77,6 +93,32 @@ def test_a_store_filled_by_other_code_is_refused(tmp_path: Path) -> None:
         open_cache(str(unstamped))
     assert open_cache(str(tmp_path / "new")) == tmp_path / "new"  # a fresh one is stamped
     assert (tmp_path / "new" / STAMP).read_text().strip() == fingerprint()
+    # the same code, but entries of the form before the start's depth was stored
+    older = tmp_path / "older"
+    open_cache(str(older), fingerprint())
+    (older / "build_a_tower-3-lod.pkl.gz").write_bytes(b"a list of judged subtasks")
+    done = _agreement(older)
+    assert done.returncode != 0 and "give --cache a fresh directory" in done.stderr, done.stderr
+
+
+def test_the_start_depth_counts_the_plans_objects_fused_not_resting_or_clutter() -> None:
+    """Two of the plan's blocks placed into each other start fused; one resting on the other after
+    settling does not (a contact sinks a fraction of a millimetre); two clutter objects fused into
+    each other do not count: the subtasks never touch them."""
+    plan = make_planner("offline").plan("build a tower")
+
+    def depth(*objects: ObjectSpec, settle: float = 0.0) -> float:
+        scene = SceneSpec(objects=objects)
+        world = compose(scene).make_world()
+        world.settle(settle)
+        start = Attempt(0, Stage.ACCEPTED, "", scene, world=world, initial_state=world.get_state())
+        return _start_depth(start, plan)
+
+    assert depth(ObjectSpec("base", "block", (0.5, 0.0)), ObjectSpec("middle", "block", (0.52, 0.0))) > FUSED
+    stacked = (ObjectSpec("base", "block", (0.5, 0.0)), ObjectSpec("middle", "block", (0.5, 0.0), z=0.8))
+    assert 0.0 < depth(*stacked, settle=0.5) < FUSED
+    assert depth(ObjectSpec("base", "block", (0.5, 0.2)), ObjectSpec("c0", "block", (0.5, 0.0)),
+                 ObjectSpec("c1", "block", (0.52, 0.0))) == 0.0
 
 
 def test_the_fingerprint_follows_the_package_but_not_its_critics(tmp_path: Path) -> None:
