@@ -169,6 +169,29 @@ def test_a_seal_on_a_coaster_lying_on_the_mat_is_not_on_the_mat() -> None:
         assert on or "seal lies over coaster" in reason, reason
 
 
+def test_a_block_put_beside_a_nudged_one_or_where_one_stood_is_on_the_table() -> None:
+    """A block put down against another nudges it a centimetre, so the sliver of the other's outline
+    before that the new block covers now is not the other block: it shows all of itself. A bottle
+    that stood where the block is put and is gone now (knocked off the table) does not hold it up:
+    the table shows where the bottle stood. The oracle counts the block on the table in both; the
+    same block put on the other block is not."""
+    sub = put_at("red", (0.55, 0.06), "the red block is on the table")
+    away = ObjectSpec("red", "block", (0.45, -0.15))
+    blue = ObjectSpec("blue", "block", (0.55, 0.1))
+    nudged = ObjectSpec("blue", "block", (0.55, 0.11))
+    accept, reason, oracle = _judge_typed(_world(away, blue), _world(ObjectSpec("red", "block", (0.55, 0.06)),
+                                                                      nudged), sub)
+    assert oracle["on_table(red)"] and accept, reason
+    on_blue = _world(ObjectSpec("red", "block", (0.55, 0.1), z=0.8), blue)
+    accept, reason, oracle = _judge_typed(_world(away, blue), on_blue, sub)
+    assert not oracle["on_table(red)"] and not accept, reason
+    bottle = ObjectSpec("bottle", "bottle", (0.55, 0.06))
+    gone = ObjectSpec("bottle", "bottle", (1.6, 0.0), z=0.05)
+    after = _world(ObjectSpec("red", "block", (0.55, 0.06)), gone)
+    accept, reason, oracle = _judge_typed(_world(away, bottle), after, sub)
+    assert oracle["on_table(red)"] and accept, reason
+
+
 def test_a_cup_standing_on_a_stand_over_its_coaster_is_not_on_it() -> None:
     """Seen from above, a cup shows its floor inside its rim: its top is the rim, at its outline.
     Standing on a stand over the coaster (one the top view did not show before, so nothing there

@@ -14,12 +14,12 @@ simulator state. Each predicate is checked in image space:
   lowest pixel row lies within ``b``'s rows (for ``inside``, no lower than ``b``'s bottom). With the
   top view's depth, ``a`` is down on ``b``: its lowest point is no higher than its type's height
   above ``b``'s surface (for ``inside``, its rim), and it does not lie over another object that
-  stood higher than that surface before the subtask (clutter on the target; a flat one, such as a
-  phone lying on the target, where it lay under most of ``a``'s outline); an object that stood on
-  its base with a curved top before and shows a flat one now, or a domed one that barely bends now,
-  lies turned over, and one taller than wide whose top is now nearer its height lying on a side than
-  its height standing (read before, on the table; where it did not stand there, the bounds its
-  type's scales allow) lies on its side (neither asked in a container,
+  stood higher than that surface before the subtask and is still there (clutter on the target; a
+  flat one, such as a phone lying on the target, where it lay under most of ``a``'s outline); an
+  object that stood on its base with a curved top before and shows a flat one now, or a domed one
+  that barely bends now, lies turned over, and one taller than wide whose top is now nearer its
+  height lying on a side than its height standing (read before, on the table; where it did not
+  stand there, the bounds its type's scales allow) lies on its side (neither asked in a container,
   where it may lie any way up; the side is asked also where ``a`` hides ``b``). Put down, ``a``'s
   top (an open container's: its rim, at its outline) stands no higher than its type's height above
   that surface (on a surface that leans, a stand's ramp, its longest side across tilted with the
@@ -96,6 +96,7 @@ from vcage.critics.masks import (
 from vcage.registry import Registry
 
 ROBOT = -2
+BARE = -1  # what is neither an object nor the robot (the table, the floor) in a segmentation
 TOP, FRONT = "top", "front"
 MIN_OVERLAP = 0.6  # share of the smaller region's (by hull) pixels that must overlap the other's hull
 CENTRE_TOL = 2  # pixels (about 1 cm) by which an object's centre may lie outside its support's hull
@@ -306,8 +307,10 @@ def _landed_on_other(obs: Observation, top: View, a: str, b: str, inside: bool) 
     - ``a`` rests on ``b``'s rim (see :func:`_on_rim`).
     - ``a`` lies over another object ``c`` whose top stood more than :data:`SUPPORT_TOL` above that
       surface (:data:`THIN_SUPPORT` under most of ``a``'s outline): before the subtask the top view
-      showed ``c`` where ``a`` is seen now, and ``c`` is still there (followed if it was pushed), so
-      ``a`` lies above ``c`` and cannot be down on ``b``.
+      showed ``c`` where ``a`` is seen now, and ``c`` is still there (followed if it was pushed; one
+      that stayed shows less of itself than before, not a neighbour nudged against ``a``; one the
+      table shows through where it stood, beside ``a``, is gone), so ``a`` lies above ``c`` and
+      cannot be down on ``b``.
       Not asked of ``a`` leaning in ``b``: it may lean against ``c`` standing in ``b`` (a loaf on
       a cup that stood in the basket, its lower end on the floor); its lower end decides.
     """
@@ -458,12 +461,18 @@ def _not_down(obs: Observation, top: View, a: str, surface: float | None, floor:
         if c in skip or not was.any():
             continue
         now = top.segmentation == i
-        dr, dc = (0, 0)
-        if now.any() and (now & dilate(was, TOUCH)).sum() < STILL * now.sum():
-            dr, dc = best_shift(was, now)  # pushed: follow it
-        under = shift(was, dr, dc) & ma & ~dilate(now, 1)
-        if under.sum() < UNDER_PX:
+        pushed = now.any() and (now & dilate(was, TOUCH)).sum() < STILL * now.sum()
+        dr, dc = best_shift(was, now) if pushed else (0, 0)  # pushed: follow it
+        outline = shift(was, dr, dc)
+        under = outline & ma & ~dilate(now, 1)
+        # where ``c`` stayed, ``a`` hides of it what it no longer shows: nudged a pixel or two (not
+        # followed), it still shows all of itself, and the sliver of its outline under ``a`` is not ``c``
+        hidden = int(under.sum()) if pushed else min(int(under.sum()), int(was.sum()) - int(now.sum()))
+        if hidden < UNDER_PX:
             continue
+        beside = outline & ~dilate(ma, 1)  # where ``c`` would show if it still lay under ``a``
+        if (beside & (top.segmentation == BARE)).sum() > beside.sum() / 2:
+            continue  # the table shows there: ``c`` is gone (knocked off, out of sight)
         rise = float(np.median(shift(np.where(was, hb, 0.0), dr, dc)[under])) - surface
         if rise > SUPPORT_TOL or (rise > THIN_SUPPORT and under.sum() >= MIN_OVERLAP * ma.sum()):
             return f"{a} lies over {c}, whose top is {100 * rise:.1f} cm above {where}"
