@@ -192,6 +192,21 @@ def test_a_block_put_beside_a_nudged_one_or_where_one_stood_is_on_the_table() ->
     assert oracle["on_table(red)"] and accept, reason
 
 
+def test_a_cube_that_stood_tilted_and_lies_flat_now_is_not_turned_over() -> None:
+    """A block rests on any face (the oracle's cube): one that leaned before the subtask, so that
+    the top view showed two of its faces, and lies flat on its base block now shows a plane where
+    it showed a bend, as a mouse turned onto its back does, but it is on the base."""
+    base = ObjectSpec("base", "block", (0.55, 0.1))
+    leaning = ObjectSpec("middle", "block", (0.45, -0.15), z=0.77)  # in the air: only the views count
+    before = compose(SceneSpec(objects=(leaning, base))).make_world()
+    adr = before.model.jnt_qposadr[before.model.body_jntadr[before.object("middle").body_id]]
+    before.data.qpos[adr + 3:adr + 7] = (np.cos(0.15), np.sin(0.15), 0.0, 0.0)  # leaning 0.3 rad
+    before.forward()
+    after = _world(ObjectSpec("middle", "block", (0.55, 0.115), z=0.8), base)  # the base shows beside it
+    accept, reason, oracle = _judge_typed(before, after, put_on("middle", "base", "the block is on the base"))
+    assert oracle["on(middle, base)"] and accept, reason
+
+
 def test_a_cup_standing_on_a_stand_over_its_coaster_is_not_on_it() -> None:
     """Seen from above, a cup shows its floor inside its rim: its top is the rim, at its outline.
     Standing on a stand over the coaster (one the top view did not show before, so nothing there

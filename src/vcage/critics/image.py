@@ -17,10 +17,11 @@ simulator state. Each predicate is checked in image space:
   stood higher than that surface before the subtask and is still there (clutter on the target; a
   flat one, such as a phone lying on the target, where it lay under most of ``a``'s outline); an
   object that stood on its base with a curved top before and shows a flat one now, or a domed one
-  that barely bends now, lies turned over, and one taller than wide whose top is now nearer its
-  height lying on a side than its height standing (read before, on the table; where it did not
-  stand there, the bounds its type's scales allow) lies on its side (neither asked in a container,
-  where it may lie any way up; the side is asked also where ``a`` hides ``b``). Put down, ``a``'s
+  that barely bends now, lies turned over (not a cube: it rests on any face), and one taller than
+  wide whose top is now nearer its height lying on a side than its height standing (read before, on
+  the table; where it did not stand there, the bounds its type's scales allow) lies on its side
+  (neither asked in a container, where it may lie any way up; the side is asked also where ``a``
+  hides ``b``). Put down, ``a``'s
   top (an open container's: its rim, at its outline) stands no higher than its type's height above
   that surface (on a surface that leans, a stand's ramp, its longest side across tilted with the
   ramp; in a container, where its top view shows it turned or its top slopes as a leaning object's
@@ -515,10 +516,10 @@ def _turned_over(obs: Observation, top: View, a: str) -> str | None:
     back shows its flat underside; or its top was a dome and bends down under :data:`FLAT_BEND` as
     much now (a mouse tipped over at a slant shows a flat face and part of its dome; see
     :func:`_dome`). Containers are left out: how much of their inside shows changes with what stands
-    around them."""
+    around them; so are cubes, which rest on any face."""
     otype = _type_of(obs, a)
     before = obs.before.get(TOP)
-    if otype is None or before is None or before.pixel_size is None or _open(otype):
+    if otype is None or before is None or before.pixel_size is None or _open(otype) or otype.any_face:
         return None
     mask = _mask(obs, before, a)
     if not _on_its_base(otype, before, mask):
