@@ -10,22 +10,21 @@ simulator state. Each predicate is checked in image space:
   ``b``'s outline (or, when ``a`` is the larger, ``b``'s in ``a``'s; on a cube, whose surface is its
   whole face, only the centre counts) and ``a``'s centre lies over it; ``b``'s outline is its
   visible pixels plus its outline from before, moved to where it is now (``a`` may hide ``b``, and
-  both may have moved). In the front view ``a`` rests on ``b``: its
-  lowest pixel row lies within ``b``'s rows (for ``inside``, no lower than ``b``'s bottom). With the
-  top view's depth, ``a`` is down on ``b``: its lowest point is no higher than its type's height
-  above ``b``'s surface (for ``inside``, its rim), and it does not lie over another object that
-  stood higher than that surface before the subtask and is still there (clutter on the target; a
-  flat one, such as a phone lying on the target, where it lay under most of ``a``'s outline); an
-  object that stood on its base with a curved top before and shows a flat one now, or a domed one
-  that barely bends now, lies turned over (not a cube: it rests on any face), and one taller than
-  wide whose top is now nearer its height lying on a side than its height standing (read before, on
-  the table; where it did not stand there, the bounds its type's scales allow) lies on its side
-  (neither asked in a container, where it may lie any way up; the side is asked also where ``a``
-  hides ``b``). Put down, ``a``'s
-  top (an open container's: its rim, at its outline) stands no higher than its type's height above
-  that surface (on a surface that leans, a stand's ramp, its longest side across tilted with the
-  ramp; in a container, where its top view shows it turned or its top slopes as a leaning object's
-  does, its longest side above the rim). In a container its underside, its own height (seen on the table
+  both may have moved). In the front view ``a`` rests on ``b``: its lowest pixel row lies within
+  ``b``'s rows (for ``inside``, no lower than ``b``'s bottom). With the top view's depth, ``a`` is
+  down on ``b``: its lowest point is no higher than its type's height above ``b``'s surface (for
+  ``inside``, its rim), and it does not lie over another object that stood higher than that surface
+  before the subtask and is still there (clutter on the target; a flat one, such as a phone lying on
+  the target, where it lay under most of ``a``'s outline); an object that stood on its base with a
+  curved top before and shows a flat one now, or a domed one that barely bends now, lies turned over
+  (not a cube: it rests on any face), and one taller than wide whose top is now nearer its height
+  lying on a side than its height standing (read before, on the table; where it did not stand there,
+  the bounds its type's scales allow) lies on its side (neither asked in a container, where it may
+  lie any way up; the side is asked also where ``a`` hides ``b``). Put down, ``a``'s top (an open
+  container's: its rim, at its outline) stands no higher than its type's height above that surface
+  (on a surface that leans, a stand's ramp, its longest side across tilted with the ramp; in a
+  container, where its top view shows it turned or its top slopes as a leaning object's does, its
+  longest side above the rim). In a container its underside, its own height (seen on the table
   before) under its top, or under its top's lower end where it leans, lies below the rim (not
   resting on it). In a drawer (a placement that comes out with a joint) the drawer is still open
   after the subtask, and ``a`` lies over what came out of ``b`` (not on its body), below the
