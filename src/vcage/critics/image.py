@@ -380,7 +380,7 @@ def _own_height(obs: Observation, a: str, outline: bool = False) -> float | None
     if before is None or hb is None:
         return None
     was = _mask(obs, before, a)
-    ring = dilate(was, 2) & ~dilate(was, 1) & (before.segmentation == -1)
+    ring = dilate(was, 2) & ~dilate(was, 1) & (before.segmentation == BARE)
     if not was.any() or ring.sum() < UNDER_PX or float(np.median(hb[ring])) > HEIGHT_TOL:
         return None
     return _highest(hb, was, rim=outline)
@@ -699,9 +699,9 @@ def _touch_depth(view: View) -> np.ndarray | None:
 
 def _heights(view: View) -> np.ndarray | None:
     """Heights above the table of what each pixel of an orthographic view with depth sees."""
-    if view.depth is None or view.pixel_size is None or not np.any(view.segmentation == -1):
+    if view.depth is None or view.pixel_size is None or not np.any(view.segmentation == BARE):
         return None
-    return float(np.median(view.depth[view.segmentation == -1])) - view.depth
+    return float(np.median(view.depth[view.segmentation == BARE])) - view.depth
 
 
 def _highest(heights: np.ndarray, mask: np.ndarray, rim: bool = False) -> float:
