@@ -143,6 +143,25 @@ def test_vanilla_accepts_without_a_critic(tmp_path: Path) -> None:
     assert audit(out).judged_subtasks == 0
 
 
+def test_a_vanilla_episode_that_starts_fused_says_so_in_its_log_and_audit(tmp_path: Path) -> None:
+    """Naive placement put the bell 2 cm into an alarm clock (seed 6, eight distractors), and
+    settling left them so: the attempt log names the pair and its depth, and the audit counts the
+    accepted episode among those that started fused. A checked scene never starts so."""
+    out = tmp_path / "fused"
+    generate(SHORT, 1, out, GenerateConfig.vanilla(seed=6, clutter=8, render=RenderConfig(size=(64, 64))))
+    record = json.loads((out / ATTEMPTS_LOG).read_text().splitlines()[-1])
+    [(a, b, depth)] = record["fused_at_start"]
+    assert {a, b} == {"bell", "clutter5_alarm_clock"} and depth > 0.01
+    report = audit(out)
+    assert (report.accepted, report.accepted_fused) == (1, 1)
+    assert report.noise_where(True) == 0.0 and report.noise_where(False) is None
+    assert "1 of them started with the plan's objects fused" in report.summary()
+    checked = tmp_path / "checked"
+    generate(SHORT, 1, checked, GenerateConfig(seed=6, **SMALL))
+    assert json.loads((checked / ATTEMPTS_LOG).read_text().splitlines()[-1])["fused_at_start"] == []
+    assert audit(checked).accepted_fused == 0 and "fused" not in audit(checked).summary()
+
+
 def test_ungroundable_instruction_writes_nothing(tmp_path: Path) -> None:
     out = tmp_path / "none"
     with pytest.raises(PlanningError):

@@ -8,7 +8,7 @@ from vcage.scene.compose import compose
 from vcage.scene.layout import Distractors, LayoutSpec
 from vcage.scene.placement import place
 from vcage.scene.spec import ObjectSpec, SceneSpec
-from vcage.scene.stability import check_stability
+from vcage.scene.stability import StabilityConfig, check_stability, fused
 from vcage.skills.reachability import reach_map
 
 
@@ -60,3 +60,23 @@ def test_objects_on_and_in_supports_rest_stably():
                       np.random.default_rng(seed), reach=reach_map()).scene
         report = _check(scene)
         assert report.ok, report.reason()
+
+
+def test_fused_names_the_objects_placed_into_each_other_not_resting_or_unnamed_ones():
+    """Two named blocks placed into each other are fused; one resting on the other after settling is
+    not (a contact sinks a fraction of a millimetre); two other objects fused together are not
+    named: only pairs with one of ``names`` count."""
+    bound = StabilityConfig().penetration
+
+    def pairs(*objects: ObjectSpec, settle: float = 0.0) -> tuple[tuple[str, str, float], ...]:
+        world = compose(SceneSpec(objects=objects)).make_world()
+        world.settle(settle)
+        world.forward()
+        return fused(world, {"base", "middle"}, bound)
+
+    placed = pairs(ObjectSpec("base", "block", (0.5, 0.0)), ObjectSpec("middle", "block", (0.52, 0.0)))
+    assert [p[:2] for p in placed] == [("base", "middle")] and placed[0][2] > bound
+    stacked = (ObjectSpec("base", "block", (0.5, 0.0)), ObjectSpec("middle", "block", (0.5, 0.0), z=0.8))
+    assert pairs(*stacked, settle=0.5) == ()
+    assert pairs(ObjectSpec("base", "block", (0.5, 0.2)), ObjectSpec("c0", "block", (0.5, 0.0)),
+                 ObjectSpec("c1", "block", (0.52, 0.0))) == ()

@@ -2,7 +2,9 @@
 
 Every attempt (accepted or rejected) is logged with the critic's verdict and the oracle's audit
 of each subtask it ran. Label noise is the share of accepted episodes that the oracle says failed;
-agreement compares the critic's per-subtask verdicts with the oracle's (accept = positive).
+agreement compares the critic's per-subtask verdicts with the oracle's (accept = positive). Where
+accepted episodes started with the plan's objects fused into another object (a scene no check
+looked at: Vanilla), their label noise is reported apart from the others'.
 """
 
 from __future__ import annotations
@@ -22,6 +24,8 @@ class AuditReport:
     attempts: int
     accepted: int
     accepted_oracle_failed: int
+    accepted_fused: int  # accepted episodes that started with the plan's objects fused into another
+    accepted_fused_oracle_failed: int
     judged_subtasks: int
     true_accept: int
     false_accept: int  # critic accepted, oracle says failed
@@ -31,6 +35,13 @@ class AuditReport:
     @property
     def label_noise(self) -> float:
         return self.accepted_oracle_failed / self.accepted if self.accepted else 0.0
+
+    def noise_where(self, fused: bool) -> float | None:
+        """Label noise among the accepted episodes that started fused (or clear); None without any."""
+        n, bad = self.accepted_fused, self.accepted_fused_oracle_failed
+        if not fused:
+            n, bad = self.accepted - n, self.accepted_oracle_failed - bad
+        return bad / n if n else None
 
     @property
     def agreement(self) -> float:
@@ -54,6 +65,11 @@ class AuditReport:
     def summary(self) -> str:
         head = (f"{self.accepted} accepted episodes of {self.attempts} attempts; label noise "
                 f"{self.label_noise:.1%} ({self.accepted_oracle_failed} accepted episodes fail the oracle)\n")
+        if self.accepted_fused:
+            clear = self.noise_where(False)
+            head += (f"{self.accepted_fused} of them started with the plan's objects fused into another "
+                     f"object (no scene check): label noise {self.noise_where(True):.1%} there, "
+                     + (f"{clear:.1%} on the others\n" if clear is not None else "no other episode\n"))
         if not self.judged_subtasks:
             return head + "no critic verdicts to compare (Vanilla mode, or no subtask was judged)"
         return (head +
@@ -68,13 +84,17 @@ def audit(root: Path) -> AuditReport:
     if not path.is_file():
         raise DatasetError(f"{path} is missing: the dataset was not made by `vcage generate`, or its "
                            "attempt log was removed")
-    counts = dict.fromkeys(("attempts", "accepted", "accepted_oracle_failed", "judged_subtasks",
-                            "true_accept", "false_accept", "false_reject", "true_reject"), 0)
+    counts = dict.fromkeys(("attempts", "accepted", "accepted_oracle_failed", "accepted_fused",
+                            "accepted_fused_oracle_failed", "judged_subtasks", "true_accept",
+                            "false_accept", "false_reject", "true_reject"), 0)
     for rec in read(path, torn_tail=False):
         counts["attempts"] += 1
         if rec["stage"] == Stage.ACCEPTED:
+            fused = bool(rec.get("fused_at_start"))  # absent from logs written before it was recorded
             counts["accepted"] += 1
             counts["accepted_oracle_failed"] += not rec["oracle_success"]
+            counts["accepted_fused"] += fused
+            counts["accepted_fused_oracle_failed"] += fused and not rec["oracle_success"]
         for audit_row, verdict in zip(rec["audit"], rec["verdicts"], strict=False):
             if not verdict:
                 continue

@@ -24,6 +24,7 @@ from vcage.planning.schema import Plan
 from vcage.scene.compose import compose
 from vcage.scene.instantiate import Instantiator, SceneInstance
 from vcage.scene.spec import SceneSpec
+from vcage.scene.stability import StabilityConfig, fused
 from vcage.sim.render import Renderer
 from vcage.sim.world import World
 from vcage.skills.base import Skills
@@ -82,6 +83,9 @@ class Attempt:
     recording: Recording | None = None
     world: World | None = None
     initial_state: np.ndarray | None = None
+    # pairs of objects (one the plan's) interpenetrating deeper than the scene check's bound where
+    # the rollout started (only a scene that was not checked starts so): (a, b, depth in metres)
+    fused: tuple[tuple[str, str, float], ...] = ()
     timing: Timing = field(default_factory=Timing)
     critic_view: bytes | None = None  # PNG of the views the critic rejected (:mod:`.critic_views`)
 
@@ -141,6 +145,17 @@ def _attempt(plan: Plan, seed: int, cfg: GenerateConfig, critic: Critic | None, 
         timing.physics += instance.world.physics_seconds - settled
 
 
+def _fused_at(world: World, state: np.ndarray, plan: Plan) -> tuple[tuple[str, str, float], ...]:
+    """The plan's objects fused into another object in ``state`` (see :func:`~vcage.scene.stability.fused`),
+    read after the rollout so that it runs as it would unread; ``world`` is left as it ended."""
+    end = world.get_state()
+    world.set_state(state)
+    named = frozenset(n for s in plan.subtasks for n in s.objects())
+    pairs = fused(world, named, StabilityConfig().penetration)
+    world.set_state(end)
+    return pairs
+
+
 def _execute(plan: Plan, seed: int, cfg: GenerateConfig, critic: Critic | None, timing: Timing,
              instance: SceneInstance) -> Attempt:
     scene, world = instance.spec, instance.world
@@ -166,7 +181,8 @@ def _execute(plan: Plan, seed: int, cfg: GenerateConfig, critic: Critic | None, 
                 timing.critic_views += time.perf_counter() - t0
     except SimulationError as exc:
         return Attempt(seed, Stage.PHYSICS, str(exc), scene)
-    out = Attempt(seed, Stage.ACCEPTED, "", scene, rollout, skills.player.recording, world, initial)
+    out = Attempt(seed, Stage.ACCEPTED, "", scene, rollout, skills.player.recording, world, initial,
+                  _fused_at(world, initial, plan))
     if rollout.aborted_at is not None:
         last = rollout.outcomes[-1]
         if last.skill_error is not None:

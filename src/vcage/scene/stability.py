@@ -75,6 +75,18 @@ def penetrations(world: World, depth: float) -> list[tuple[str, str, float]]:
     return found
 
 
+def fused(world: World, names: set[str] | frozenset[str], depth: float) -> tuple[tuple[str, str, float], ...]:
+    """The pairs of objects, one of them in ``names``, whose deepest contact (as the world's contacts
+    stand) is deeper than ``depth``, deepest first: objects fused into each other, as naive placement
+    leaves them even after settling (objects resting on one another sink well under a millimetre)."""
+    objects, deepest = set(world.object_names), dict[tuple[str, str], float]()
+    for a, b, d in penetrations(world, depth):
+        if a in objects and b in objects and (a in names or b in names):
+            key = (min(a, b), max(a, b))
+            deepest[key] = max(d, deepest.get(key, 0.0))
+    return tuple(sorted(((a, b, d) for (a, b), d in deepest.items()), key=lambda p: -p[2]))
+
+
 def check_stability(world: World, config: StabilityConfig | None = None) -> StabilityReport:
     """Check the world as composed (call before stepping it), then settle it and check again."""
     cfg = config or StabilityConfig()
