@@ -49,11 +49,10 @@ from obs_cache import cached, fingerprint, open_cache  # noqa: E402
 from vcage.config import MESH_DETAILS, RenderConfig  # noqa: E402
 from vcage.critics import Critic, CriticConfig, Observation, Verdict, make_critic  # noqa: E402
 from vcage.pipeline.config import GenerateConfig  # noqa: E402
-from vcage.pipeline.episode import Attempt, attempt  # noqa: E402
+from vcage.pipeline.episode import attempt  # noqa: E402
 from vcage.planning import make_planner  # noqa: E402
 from vcage.planning.goals import GOALS  # noqa: E402
-from vcage.planning.schema import Plan  # noqa: E402
-from vcage.scene.stability import StabilityConfig, penetrations  # noqa: E402
+from vcage.scene.stability import StabilityConfig  # noqa: E402
 
 DEFAULT_GOALS = ("get_ready_for_work", "prepare_breakfast", "tidy_the_desk", "set_the_table",
                  "build_a_tower", "sort_blocks_by_colour")
@@ -72,23 +71,10 @@ class Shadow(Critic):
 
 
 Judged = tuple[str, Observation, bool, str, str]  # scene, observation, oracle success, where, oracle
-Episode = tuple[float, list[Judged]]  # how deep the plan's objects interpenetrate at the start (m), judged
+Episode = tuple[float, list[Judged]]  # how deep the plan's objects started fused (Attempt.fused; m), judged
 Row = tuple[str, str, bool, bool, str, bool]  # goal, scene, critic accepts, oracle success, why, fused
 FUSED = StabilityConfig().penetration  # deeper than this counts as interpenetration (the scene check's bound)
 ENTRIES = "episode-v2"  # what a cache entry holds (:data:`Episode`); part of the cache's stamp
-
-
-def _start_depth(result: Attempt, plan: Plan) -> float:
-    """How deep (metres) one of ``plan``'s objects interpenetrates another object where the rollout
-    started (the scene placed and settled; Vanilla checks nothing before it), 0.0 where none does."""
-    world, state = result.world, result.initial_state
-    if world is None or state is None:
-        return 0.0
-    world.set_state(state)
-    world.forward()
-    named, objects = {n for s in plan.subtasks for n in s.objects()}, set(world.object_names)
-    return max((d for a, b, d in penetrations(world, 0.0)
-                if a in objects and b in objects and (a in named or b in named)), default=0.0)
 
 
 def _rollout(goal: str, episode: int, mesh_detail: str) -> Episode:
@@ -103,7 +89,7 @@ def _rollout(goal: str, episode: int, mesh_detail: str) -> Episode:
     scene = hashlib.sha1(json.dumps(result.scene.to_dict() if result.scene else None, sort_keys=True,
                                     default=str).encode()).hexdigest()[:12]
     judged = [o for o in result.rollout.outcomes if o.verdict is not None]
-    return _start_depth(result, plan), [
+    return max((d for *_, d in result.fused), default=0.0), [
         (scene, obs, o.oracle_success, f"seed {episode} subtask {o.index + 1}", str(o.oracle))
         for o, obs in zip(judged, shadow.seen, strict=True)]
 

@@ -1,7 +1,7 @@
 """``benchmarks/critic_agreement.py --cache``: Vanilla rollouts are stored once and re-judged from the
 store (a changed critic is measured in seconds); an entry is written whole or not at all, and a
 store filled by other code than the checkout's (outside ``vcage/critics``) is refused. The table is
-split by how deep the plan's objects interpenetrate where the rollout starts."""
+split by how deep the plan's objects were fused into another object where the rollout started."""
 
 from __future__ import annotations
 
@@ -17,13 +17,8 @@ import pytest
 BENCHMARKS = Path(__file__).resolve().parents[2] / "benchmarks"
 sys.path.insert(0, str(BENCHMARKS))
 
-from critic_agreement import FUSED, _start_depth  # noqa: E402
+from critic_agreement import FUSED  # noqa: E402
 from obs_cache import STAMP, StaleCache, cached, fingerprint, open_cache  # noqa: E402
-from vcage.pipeline.episode import Attempt  # noqa: E402
-from vcage.pipeline.stage import Stage  # noqa: E402
-from vcage.planning import make_planner  # noqa: E402
-from vcage.scene.compose import compose  # noqa: E402
-from vcage.scene.spec import ObjectSpec, SceneSpec  # noqa: E402
 
 
 def _agreement(cache: Path) -> subprocess.CompletedProcess[str]:
@@ -99,26 +94,6 @@ def test_a_store_filled_by_other_code_is_refused(tmp_path: Path) -> None:
     (older / "build_a_tower-3-lod.pkl.gz").write_bytes(b"a list of judged subtasks")
     done = _agreement(older)
     assert done.returncode != 0 and "give --cache a fresh directory" in done.stderr, done.stderr
-
-
-def test_the_start_depth_counts_the_plans_objects_fused_not_resting_or_clutter() -> None:
-    """Two of the plan's blocks placed into each other start fused; one resting on the other after
-    settling does not (a contact sinks a fraction of a millimetre); two clutter objects fused into
-    each other do not count: the subtasks never touch them."""
-    plan = make_planner("offline").plan("build a tower")
-
-    def depth(*objects: ObjectSpec, settle: float = 0.0) -> float:
-        scene = SceneSpec(objects=objects)
-        world = compose(scene).make_world()
-        world.settle(settle)
-        start = Attempt(0, Stage.ACCEPTED, "", scene, world=world, initial_state=world.get_state())
-        return _start_depth(start, plan)
-
-    assert depth(ObjectSpec("base", "block", (0.5, 0.0)), ObjectSpec("middle", "block", (0.52, 0.0))) > FUSED
-    stacked = (ObjectSpec("base", "block", (0.5, 0.0)), ObjectSpec("middle", "block", (0.5, 0.0), z=0.8))
-    assert 0.0 < depth(*stacked, settle=0.5) < FUSED
-    assert depth(ObjectSpec("base", "block", (0.5, 0.2)), ObjectSpec("c0", "block", (0.5, 0.0)),
-                 ObjectSpec("c1", "block", (0.52, 0.0))) == 0.0
 
 
 def test_the_fingerprint_follows_the_package_but_not_its_critics(tmp_path: Path) -> None:
