@@ -84,7 +84,7 @@ class Attempt:
     world: World | None = None
     initial_state: np.ndarray | None = None
     # pairs of objects (one the plan's) interpenetrating deeper than the scene check's bound where
-    # the rollout started (only a scene that was not checked starts so): (a, b, depth in metres)
+    # the rollout started (an unchecked scene, as Vanilla's, can start so): (a, b, depth in metres)
     fused: tuple[tuple[str, str, float], ...] = ()
     timing: Timing = field(default_factory=Timing)
     critic_view: bytes | None = None  # PNG of the views the critic rejected (:mod:`.critic_views`)

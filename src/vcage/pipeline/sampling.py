@@ -84,7 +84,7 @@ def _audit(result: Attempt) -> list[dict[str, Any]]:
 
 def log_record(episode: int, index: int, result: Attempt) -> dict[str, Any]:
     """The attempt's line in ``meta/vcage_attempts.jsonl``: outcome, oracle audit, verdicts, and the
-    plan's objects fused into another object where the rollout started (a scene not checked)."""
+    plan's objects fused into another object where the rollout started (an unchecked scene can)."""
     return {"episode": episode, "attempt": index, "seed": result.seed, "stage": result.stage,
             "reason": result.reason, "oracle_success": result.oracle_success,
             "audit": _audit(result),
