@@ -16,6 +16,7 @@ from vcage.critics.base import Critic
 from vcage.errors import PlacementError, SimulationError, VcageError
 from vcage.pipeline.config import GenerateConfig
 from vcage.pipeline.critic_views import sheet_png
+from vcage.pipeline.features import objects_of
 from vcage.pipeline.plan_layout import episode_scene, plan_layout
 from vcage.pipeline.rollout import Rollout, run_plan
 from vcage.pipeline.stage import Stage
@@ -150,8 +151,7 @@ def _fused_at(world: World, state: np.ndarray, plan: Plan) -> tuple[tuple[str, s
     read after the rollout so that it runs as it would unread; ``world`` is left as it ended."""
     end = world.get_state()
     world.set_state(state)
-    named = frozenset(n for s in plan.subtasks for n in s.objects())
-    pairs = fused(world, named, StabilityConfig().penetration)
+    pairs = fused(world, frozenset(objects_of(plan)), StabilityConfig().penetration)
     world.set_state(end)
     return pairs
 
