@@ -8,7 +8,9 @@ For each task of the suite (single-subtask instructions and long-horizon goals):
 2. pick ``--eval`` held-out scenes that the scripted expert solves: evaluation scene seeds of the
    V-CAGE dataset's environment (:mod:`vcage.pipeline.evaluation`, disjoint from every generation
    seed) on which the plan's scripted execution succeeds by the oracle;
-3. train ``--policy`` on each dataset with each of ``--train-seeds`` seeds and the same budget;
+3. train ``--policy`` on each dataset with each of ``--train-seeds`` seeds and the same budget (by
+   default a diffusion policy that reads the tool's and the plan objects' poses and predicts the
+   tool's next poses, the configuration that did best on "put the mouse on the pad");
 4. evaluate every checkpoint on the same held-out scenes, in the V-CAGE environment (both datasets
    share the plan, so the policies observe and act alike; Vanilla's own environment would sample
    its unchecked scenes), and on ``--fit`` scenes of its own training episodes (column "fit"): a
@@ -20,6 +22,8 @@ not say which it means: "tasks" = the mean of the K tasks with the best success 
 = the mean over tasks of each task's K best checkpoints, which needs at least K training seeds),
 the paired bootstrap 95% interval of the V-CAGE - Vanilla gap (resampling tasks, then scenes), and
 the correlation of each task's gap with its Vanilla label noise.
+
+By default the processes are as many as the usable cores and rollouts go in batches of 8.
 
 Every step is resumable: datasets are completed (``generate(..., total=True)``), training resumes
 from its last checkpoint, finished evaluations are read back from ``WORK/results``. ``--quick`` is
@@ -41,6 +45,7 @@ from __future__ import annotations
 import argparse
 import functools
 import json
+import os
 import re
 import time
 from dataclasses import replace
@@ -57,6 +62,10 @@ SUITE = (
     "put the mouse on the pad, then press the bell",
 )
 QUICK_SUITE = ("press the bell",)
+# what the policies observe unless told: the tool's pose and the poses of the plan's objects, without the
+# joint state (with it, tool-pose policies drifted where the IK left the elbow; docs/BENCHMARKS.md, "joint
+# targets or tool poses")
+DEFAULT_OBS = ("observation.ee_pose", "observation.environment_state")
 METHODS = ("vcage", "vanilla")
 
 
@@ -401,10 +410,12 @@ def main() -> None:
     parser.add_argument("--eval", type=int, default=50, help="held-out scenes per task")
     parser.add_argument("--train-seeds", type=int, default=3)
     parser.add_argument("--policy", choices=("diffusion", "mlp"), default="diffusion")
-    parser.add_argument("--action", choices=("action", "action.ee_pose"), default="action",
-                        help="what the policies predict: joint targets, or the tool's pose (IK in the env)")
-    parser.add_argument("--obs", nargs="+", default=None,
-                        help="observation features (default: state, tool pose and environment state)")
+    parser.add_argument("--action", choices=("action", "action.ee_pose"), default="action.ee_pose",
+                        help="what the policies predict: the tool's pose (IK in the env; the default) or "
+                        "joint targets")
+    parser.add_argument("--obs", nargs="+", default=list(DEFAULT_OBS),
+                        help="observation features (default: the tool's pose and the plan objects' poses; "
+                        "'all' for the dataset's state, tool pose and environment state)")
     parser.add_argument("--subtask-conditioned", action="store_true",
                         help="condition the policies on the plan's subtask, named by a classifier head at "
                         "evaluation (hierarchical; goals only need it)")
@@ -421,9 +432,10 @@ def main() -> None:
     parser.add_argument("--seed", type=int, default=0, help="generation run seed (both methods)")
     parser.add_argument("--size", type=int, default=64, help="video size (the policy is state-based)")
     parser.add_argument("--threads", type=int, default=1, help="torch threads per process")
-    parser.add_argument("--workers", type=int, default=1,
-                        help="processes for generation, training runs and rollouts (same results as one)")
-    parser.add_argument("--eval-batch", type=int, default=1,
+    parser.add_argument("--workers", type=int, default=None,
+                        help="processes for generation, training runs and rollouts (same results as one; "
+                        "default: the usable cores, 1 with --quick)")
+    parser.add_argument("--eval-batch", type=int, default=8,
                         help="evaluation episodes stepped together, chunks sampled as one batch (faster; "
                              "results depend on it)")
     parser.add_argument("--fit", type=int, default=10,
@@ -448,6 +460,11 @@ def main() -> None:
         args.tasks = args.tasks or list(QUICK_SUITE)
         args.demos, args.eval, args.train_seeds, args.steps = 2, 1, 1, 4
         args.policy, args.max_steps, args.bootstrap, args.fit = "mlp", 20, 50, 1
+        args.workers = 1 if args.workers is None else args.workers
+    if args.workers is None:
+        args.workers = len(os.sched_getaffinity(0))
+    if args.obs == ["all"]:
+        args.obs = None
     tasks = args.tasks or list(SUITE)
     t0 = time.perf_counter()
     if args.stage == "train":
