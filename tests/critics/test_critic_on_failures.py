@@ -15,7 +15,7 @@ import pytest
 
 from critics.faulted import Run, run
 from vcage.critics.base import Verdict, View
-from vcage.critics.image import ROBOT, ImageCritic
+from vcage.critics.image import ROBOT, ImageCritic, _peak
 from vcage.critics.masks import touch
 from vcage.planning.goals import close_drawer, hang, open_drawer, press, put_in, put_on, turn_to_face
 from vcage.planning.schema import Predicate, Subtask
@@ -431,6 +431,36 @@ def test_a_press_on_a_bell_the_front_view_never_shows_is_judged_from_the_top() -
     assert hover.outcome.oracle["pressed(bell)"] is False
     verdict = CRITIC.judge(hover.obs)
     assert not verdict.accept and "short of pressing" in verdict.reason, verdict.reason
+
+
+def test_a_lone_stray_depth_pixel_inside_the_bell_is_not_its_top() -> None:
+    """One pixel inside a bell's outline in the top view read 59 cm above the table (a Vanilla rollout):
+    taken as the bell's top, the press read half a metre past a full one, "the bell gave way". The
+    top is the highest pixel that a neighbour inside comes near; a light press stays short."""
+    done = run(BELL, press("bell", "the bell is rung"))
+    light = run(BELL, press("bell", "the bell is rung"), "press_light", 0)
+    assert done.success and not light.success
+    for result, accept in ((done, True), (light, False)):
+        top = result.obs.before["top"]
+        assert top.depth is not None
+        bell = top.segmentation == result.obs.labels.index("bell")
+        rows, cols = np.nonzero(bell & ~np.roll(~bell, 2, 0) & ~np.roll(~bell, -2, 0)
+                                & ~np.roll(~bell, 2, 1) & ~np.roll(~bell, -2, 1))
+        depth = top.depth.copy()
+        depth[rows[len(rows) // 2], cols[len(cols) // 2]] -= 0.5  # one pixel inside, half a metre up
+        stray = replace(result.obs, before={**result.obs.before, "top": replace(top, depth=depth)})
+        verdict = CRITIC.judge(stray)
+        assert verdict.accept is accept, verdict.reason
+        assert "gave way" not in verdict.reason, verdict.reason
+
+
+def test_the_peak_keeps_a_one_pixel_ridge_and_drops_a_lone_spike() -> None:
+    heights = np.zeros((9, 9))
+    heights[4, 1:8] = 0.03  # a lever's ridge, one pixel wide
+    mask = np.ones_like(heights, dtype=bool)
+    assert _peak(heights, mask) == pytest.approx(0.03)
+    heights[2, 2] = 0.5  # a stray reading above everything around it
+    assert _peak(heights, mask) == pytest.approx(0.03)
 
 
 def test_a_press_that_rocks_the_clock_is_refused() -> None:

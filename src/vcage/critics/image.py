@@ -191,6 +191,10 @@ PRESS_ROOM = 0.004
 # metres of its highest point, where the button or lever is) must be this much hidden by the robot
 TOP_BAND = 0.004
 BUTTON_COVER = 0.8
+# Metres by which a pixel inside an object's outline may stand above all its neighbours there and still
+# be read as the object's top: higher, it is a stray depth reading (one pixel 59 cm above the table
+# was read inside a bell 5 cm tall). A button is several pixels wide and a lever's ridge runs on.
+SPIKE = 0.01
 # Metres by which an object below the hand's lowest pixel in the front view must be nearer the camera
 # than the hand to hide where the hand goes down (a cup's rim 1.3 cm in front of the fingers was seen)
 NEARER = 0.005
@@ -321,7 +325,7 @@ def _landed_on_other(obs: Observation, top: View, a: str, b: str, inside: bool) 
     mb = _mask(obs, before, b)
     if not mb.any():
         return None
-    rim = float(hb[_inner(mb)].max())
+    rim = _peak(hb, mb)
     surface = rim if inside else _surface(obs, b, rim)
     btype = _type_of(obs, b)
     slope = btype.placements[0].slope if btype is not None and btype.placements and not inside else 0.0
@@ -404,7 +408,7 @@ def _on_its_side(obs: Observation, top: View, a: str, b: str) -> str | None:
     if not now.any() or not mb.any():
         return None
     standing, lying = _standing_and_lying(obs, otype, before, a)
-    surface = _surface(obs, b, float(hb[_inner(mb)].max()))
+    surface = _surface(obs, b, _peak(hb, mb))
     if standing - lying < SIDE_GAP or surface is None:
         return None
     high = float(np.percentile(ha[now], 95)) - surface
@@ -729,6 +733,20 @@ def _inner(mask: np.ndarray) -> np.ndarray:
     return inner if inner.any() else mask
 
 
+def _peak(heights: np.ndarray, mask: np.ndarray) -> float:
+    """The highest point inside ``mask``'s outline (see :func:`_inner`) in a top view's ``heights``,
+    where a neighbouring pixel inside comes within :data:`SPIKE` of it: the top of a button, a rim
+    or a surface, not a lone stray reading above it."""
+    inner = _inner(mask)
+    h = np.where(inner, heights, -np.inf)
+    padded = np.pad(h, 1, constant_values=-np.inf)
+    rows, cols = h.shape
+    around = np.max([padded[1 + dy:1 + dy + rows, 1 + dx:1 + dx + cols]
+                     for dy in (-1, 0, 1) for dx in (-1, 0, 1) if dy or dx], axis=0)
+    kept = inner & (around >= h - SPIKE)
+    return float(h[kept if kept.any() else inner].max())
+
+
 def _button_cover(obs: Observation, x: str) -> float | None:
     """Share of ``x``'s top (its pixels within :data:`TOP_BAND` of its highest point before the
     subtask, where a button or lever is) that the robot hides from the top view at the subtask's
@@ -742,7 +760,7 @@ def _button_cover(obs: Observation, x: str) -> float | None:
     mask = _mask(obs, before, x)
     if not mask.any():
         return None
-    top = mask & (hb >= hb[_inner(mask)].max() - TOP_BAND)
+    top = mask & (hb >= _peak(hb, mask) - TOP_BAND)
     return float(((during.segmentation == ROBOT) & top).sum() / top.sum())
 
 
@@ -763,7 +781,7 @@ def _press_depth(obs: Observation, x: str) -> tuple[float, float, float] | None:
     over = (during.segmentation == ROBOT) & mask
     if not over.any():
         return None
-    top = float(hb[_inner(mask)].max())  # the button (lever) at rest: the object's highest point
+    top = _peak(hb, mask)  # the button (lever) at rest: the object's highest point
     scale = top / point.pos[2]  # the press point at rest is the highest point
     full = (point.travel if point.kind == "button" else point.stroke) * scale
     tcp = float(hd[over].max()) - HAND_TOP
