@@ -433,6 +433,25 @@ def test_a_press_on_a_bell_the_front_view_never_shows_is_judged_from_the_top() -
     assert not verdict.accept and "short of pressing" in verdict.reason, verdict.reason
 
 
+def test_a_press_on_a_bell_showing_a_sliver_beside_what_hides_it_is_judged_from_the_top() -> None:
+    """A pen holder in front of the bell hides all of it from the front but a sliver at its edge (a
+    Vanilla rollout): the hand goes down behind the holder, beside the sliver's columns. The bell
+    reaches on behind the holder, so where the hand met it cannot be seen, and the top view judges:
+    a full press passes, one beside the button or short of it does not."""
+    objects = (*BELL, O("holder", "pen_holder", (0.63, 0.05)))
+    done = run(objects, press("bell", "the bell is rung"))
+    front = done.obs.during["front"]
+    assert 0 < (front.segmentation == done.obs.labels.index("bell")).sum() < 10  # a sliver shows
+    assert done.success
+    verdict = CRITIC.judge(done.obs)
+    assert verdict.accept, verdict.reason
+    for fault, why in (("press_miss", "covered"), ("press_light", "short of pressing")):
+        failed = run(objects, press("bell", "the bell is rung"), fault, 0)
+        assert failed.outcome.oracle["pressed(bell)"] is False
+        verdict = CRITIC.judge(failed.obs)
+        assert not verdict.accept and why in verdict.reason, verdict.reason
+
+
 def test_a_lone_stray_depth_pixel_inside_the_bell_is_not_its_top() -> None:
     """One pixel inside a bell's outline in the top view read 59 cm above the table (a Vanilla rollout):
     taken as the bell's top, the press read half a metre past a full one, "the bell gave way". The

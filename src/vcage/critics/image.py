@@ -677,7 +677,9 @@ def _contact_hidden(obs: Observation, front: View, x: str) -> bool:
     pixels there border an object nearer the camera than the hand, so whether it met ``x`` cannot be
     seen from the front (a cup standing in front of a bell). Where the hand ends above the table or
     beside ``x`` in plain sight, its contact (or its absence) is visible. Where ``x`` shows in the
-    front view neither now nor before (a bell behind a basket), nothing there can tell."""
+    front view neither now nor before (a bell behind a basket), nothing there can tell. Where what
+    shows of ``x`` borders an object nearer the camera, ``x`` may reach on behind it: its columns count
+    as ``x``'s (a bell showing a sliver beside the pen holder that hides the rest of it)."""
     seg, depth = front.segmentation, front.depth
     mask = _mask(obs, front, x)
     if FRONT in obs.before:  # what the hand or the occluder hides now may have shown before
@@ -690,7 +692,12 @@ def _contact_hidden(obs: Observation, front: View, x: str) -> bool:
     below, below_depth = seg[1:], depth[1:]
     occluder = (robot[:-1] & (below >= 0) & (below != obs.labels.index(x))
                 & (below_depth < depth[:-1] - NEARER))
-    cols = np.nonzero(mask.any(axis=0))[0]  # the columns x spans (its visible parts may be slivers)
+    span = mask.copy()
+    for label in np.unique(seg[dilate(mask, TOUCH) & ~mask & (seg >= 0)]):
+        other = seg == label
+        if np.median(depth[other & dilate(mask, TOUCH)]) < np.median(depth[mask]) - NEARER:
+            span |= other
+    cols = np.nonzero(span.any(axis=0))[0]  # the columns x spans (its visible parts may be slivers)
     return bool(occluder[:, max(cols[0] - TOUCH, 0):cols[-1] + TOUCH + 1].any())
 
 
