@@ -14,8 +14,9 @@ import numpy as np
 import pytest
 
 from critics.faulted import Run, run
+from vcage.assets.catalog import CATALOG
 from vcage.critics.base import Verdict, View
-from vcage.critics.image import ROBOT, ImageCritic, _peak
+from vcage.critics.image import ROBOT, ImageCritic, _peak, _relief
 from vcage.critics.masks import touch
 from vcage.planning.goals import close_drawer, hang, open_drawer, press, put_in, put_on, turn_to_face
 from vcage.planning.schema import Predicate, Subtask
@@ -202,6 +203,34 @@ def test_a_mouse_on_its_back_on_the_pad_is_not_on_it() -> None:
     the top is the same). The mouse's domed top was far from a plane; its flat underside is not."""
     verdict = _mouse_set_on_the_pad((0.0, 1.0, 0.0, 0.0), 0.9)  # half a turn about x
     assert not verdict.accept and "turned over" in verdict.reason, verdict.reason
+
+
+def test_a_mouse_that_lay_on_its_back_before_and_lies_so_on_the_pad_is_not_on_it() -> None:
+    """Vanilla left mice on their backs before their subtask too, and carried them so onto the pad:
+    compared with itself before, the top kept its (flat) shape. The mouse's type declares its dome,
+    and the flat underside lies far closer to a plane than the dome does."""
+    oracle, verdict = _set_down(MOUSE_PAD, put_on("mouse", "pad", "the mouse is on the pad"),
+                                O("mouse", "mouse", (0.55, 0.12), z=0.9), (0.0, 1.0, 0.0, 0.0),
+                                lay_before=(O("mouse", "mouse", (0.5, -0.12), z=0.9), (0.0, 1.0, 0.0, 0.0)))
+    assert not oracle
+    assert not verdict.accept and "top is flat" in verdict.reason, verdict.reason
+
+
+@pytest.mark.parametrize("name", CATALOG.names_where(lambda t: t.top_relief > 0))
+def test_a_declared_top_relief_is_what_the_top_view_shows_of_the_type_standing(name: str) -> None:
+    """``ObjectType.top_relief`` is held to the model: rendered standing alone at scale 1 at four
+    headings, its top lies at least that far from a plane, and not much further on average."""
+    reliefs = []
+    for x, y, yaw in ((0.5, 0.0, 0.0), (0.55, 0.15, 1.0), (0.6, -0.15, 2.2), (0.45, 0.1, 2.9)):
+        world = compose(SceneSpec(objects=(O("x", name, (x, y), yaw=yaw),))).make_world()
+        world.settle(0.3)
+        with Renderer(world, 320, 240) as renderer:
+            top = render_views(renderer)["top"]
+        relief = _relief(top, top.segmentation == 0)
+        assert relief is not None
+        reliefs.append(relief)
+    declared = CATALOG.get(name).top_relief
+    assert declared <= min(reliefs) and declared >= 0.85 * float(np.mean(reliefs)), reliefs
 
 
 def test_a_mouse_tipped_over_at_a_slant_on_the_pad_is_not_on_it() -> None:

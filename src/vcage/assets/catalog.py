@@ -25,6 +25,10 @@ class ObjectType:
     ``any_face``: a cube whose faces are all alike (a block, a die, a Rubik's cube); it rests on
     whichever face is down and carries what is put on whichever face is up (its placement ``pos`` is
     the top face's centre).
+    ``top_relief``: how far (RMS, metres) its top, seen from straight above as it stands on its base
+    at scale 1, lies from the plane that fits it best; declared for a domed top (a mouse), so that a
+    critic can tell the flat underside of one lying on its back without having seen it upright
+    (0: not declared). ``tests/critics`` holds each declared value to the rendered model.
     """
 
     name: str
@@ -39,6 +43,7 @@ class ObjectType:
     annotations: Annotations = Annotations()
     fixed: bool = False
     any_face: bool = False
+    top_relief: float = 0.0
 
     def __post_init__(self) -> None:
         if not self.colors:

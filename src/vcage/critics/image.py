@@ -138,6 +138,12 @@ UNDER_PX = 4
 # (a mouse on its back); MIN_RELIEF_PX inner pixels are needed to tell
 CURVED = 0.003
 FLAT_TOP = 0.3
+# A type that declares its top's relief standing (``ObjectType.top_relief``, a mouse's dome) lies
+# turned over when its top lies less than TYPE_FLAT of that (at its smallest scale) from a plane,
+# whatever it showed before the subtask: Vanilla left mice on their backs before the subtask too, and
+# carried them so onto the pad. Mice the oracle found on the pad read 3.2 mm and more (6.6 mm standing
+# alone at scale 1), mice on their backs or tipped onto a side at most 2.0 mm
+TYPE_FLAT = 0.5
 MIN_RELIEF_PX = 12
 # ... or a top that was a dome (a quadric leaves under DOME_FIT of its relief from a plane: mice
 # 0.2-0.5, a seal's knob on its disc 0.5-1.0) and now bends down under FLAT_BEND as much as it did:
@@ -518,16 +524,29 @@ def _turned_over(obs: Observation, top: View, a: str) -> str | None:
     from a plane), and its top is now nearly flat (under :data:`FLAT_TOP` of that), as a mouse on its
     back shows its flat underside; or its top was a dome and bends down under :data:`FLAT_BEND` as
     much now (a mouse tipped over at a slant shows a flat face and part of its dome; see
-    :func:`_dome`). Containers are left out: how much of their inside shows changes with what stands
-    around them; so are cubes, which rest on any face."""
+    :func:`_dome`); or its type declares a domed top (``top_relief``) and its top is far flatter
+    (under :data:`TYPE_FLAT` of that), whatever it showed before. Containers are left out: how much of
+    their inside shows changes with what stands around them; so are cubes, which rest on any face."""
     otype = _type_of(obs, a)
     before = obs.before.get(TOP)
     if otype is None or before is None or before.pixel_size is None or _open(otype) or otype.any_face:
         return None
+    now = _relief(top, _mask(obs, top, a))
+    flat = TYPE_FLAT * otype.top_relief * otype.scale_range[0]
+    why = _flatter_than_before(obs, top, a, otype, before, now)
+    if why is None and now is not None and now < flat:
+        return (f"{a}'s top is flat ({1000 * now:.1f} mm from a plane; {otype.name} standing shows at least "
+                f"{1000 * flat / TYPE_FLAT:.1f} mm): it lies turned over")
+    return why
+
+
+def _flatter_than_before(obs: Observation, top: View, a: str, otype: ObjectType, before: View,
+                         now: float | None) -> str | None:
+    """The first two reasons of :func:`_turned_over` (``now``: the relief of ``a``'s top after)."""
     mask = _mask(obs, before, a)
     if not _on_its_base(otype, before, mask):
         return None  # not standing on its base before (a tilted block shows a side: two faces, no plane)
-    was, now = _relief(before, mask), _relief(top, _mask(obs, top, a))
+    was = _relief(before, mask)
     if was is None or now is None or was < CURVED:
         return None
     if now < FLAT_TOP * was:
