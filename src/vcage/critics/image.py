@@ -711,10 +711,10 @@ def _contact_hidden(obs: Observation, front: View, x: str) -> bool:
     below, below_depth = seg[1:], depth[1:]
     occluder = (robot[:-1] & (below >= 0) & (below != obs.labels.index(x))
                 & (below_depth < depth[:-1] - NEARER))
-    span = mask.copy()
-    for label in np.unique(seg[dilate(mask, TOUCH) & ~mask & (seg >= 0)]):
+    span, ring = mask.copy(), dilate(mask, TOUCH)
+    for label in np.unique(seg[ring & ~mask & (seg >= 0)]):  # objects beside what shows of x, nearer
         other = seg == label
-        if np.median(depth[other & dilate(mask, TOUCH)]) < np.median(depth[mask]) - NEARER:
+        if np.median(depth[other & ring]) < np.median(depth[mask]) - NEARER:
             span |= other
     cols = np.nonzero(span.any(axis=0))[0]  # the columns x spans (its visible parts may be slivers)
     return bool(occluder[:, max(cols[0] - TOUCH, 0):cols[-1] + TOUCH + 1].any())
