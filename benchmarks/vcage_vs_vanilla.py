@@ -34,6 +34,7 @@ from vcage.pipeline.audit import audit  # noqa: E402
 from vcage.pipeline.config import GenerateConfig  # noqa: E402
 from vcage.pipeline.generate import generate  # noqa: E402
 from vcage.planning.goals import GOALS  # noqa: E402
+from vcage.scene.stability import StabilityConfig  # noqa: E402
 
 DEFAULT_GOALS = ("get_ready_for_work", "prepare_breakfast", "tidy_the_desk", "set_the_table",
                  "build_a_tower", "sort_blocks_by_colour")
@@ -120,7 +121,8 @@ def main() -> None:
           "agree/prec/recall: image critic vs oracle on judged subtasks (accept = positive); "
           "verif/c-h: oracle-confirmed accepted episodes per core-hour; t/(p+r): total time over "
           "physics plus rendering; fused: accepted episodes that started with the plan's objects fused "
-          "into another object (deeper than 1 mm); n|clear: label noise of the other accepted episodes")
+          f"into another object (deeper than {1000 * StabilityConfig().penetration:.0f} mm); n|clear: label "
+          "noise of the other accepted episodes")
     stages: dict[str, dict[str, int]] = {}
     for r in rows:
         for stage, n in r["stages"].items():

@@ -68,7 +68,8 @@ class AuditReport:
         if self.accepted_fused:
             clear = self.noise_where(False)
             head += (f"{self.accepted_fused} of them started with the plan's objects fused into another "
-                     f"object (deeper than 1 mm): label noise {self.noise_where(True):.1%} there, "
+                     "object (deeper than the scene check allows): label noise "
+                     f"{self.noise_where(True):.1%} there, "
                      + (f"{clear:.1%} on the others\n" if clear is not None else "no other episode\n"))
         if not self.judged_subtasks:
             return head + "no critic verdicts to compare (Vanilla mode, or no subtask was judged)"
