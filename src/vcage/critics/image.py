@@ -16,7 +16,8 @@ simulator state. Each predicate is checked in image space:
   ``inside``, its rim), and it does not lie over another object that stood higher than that surface
   before the subtask and is still there (clutter on the target; a flat one, such as a phone lying on
   the target, where it lay under most of ``a``'s outline); an object that stood on its base with a
-  curved top before and shows a flat one now, or a domed one that barely bends now, lies turned over
+  curved top before and shows a flat one now, or a domed one that barely bends now, lies turned over,
+  as does one whose type declares a domed top (a mouse) and whose top is far flatter than that
   (not a cube: it rests on any face), and one taller than wide whose top is now nearer its height
   lying on a side than its height standing (read before, on the table; where it did not stand there,
   the bounds its type's scales allow) lies on its side (neither asked in a container, where it may
