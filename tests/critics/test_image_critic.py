@@ -7,6 +7,7 @@ import pytest
 
 from vcage.critics.base import Observation, View
 from vcage.critics.image import ImageCritic
+from vcage.critics.masks import best_move, moved
 from vcage.pipeline.verifier import render_views
 from vcage.planning.goals import put_at, put_on
 from vcage.planning.schema import Predicate, Subtask
@@ -245,3 +246,17 @@ def test_a_phone_standing_on_its_edge_in_the_stand_is_not_on_it() -> None:
     assert not accept and "higher than phone standing on stand's surface reaches" in reason, reason
     accept, reason, oracle = _judge_typed(before, set_in_slot(0.35), sub)  # down on the ramp
     assert oracle["on(phone, stand)"] and accept, reason
+
+
+def test_an_outline_is_followed_through_a_turn_as_well_as_a_slide() -> None:
+    """``best_move`` finds the turn (of those it is given) and the translation that lay a mask over
+    its turned and moved self, which a translation alone cannot."""
+    before = np.zeros((120, 160), dtype=bool)
+    before[40:60, 30:70] = True  # 20 by 40 pixels
+    rows, cols = np.nonzero(before)
+    now = moved(before, (24.0, float(rows.mean()), float(cols.mean()), 30, 50))
+    move = best_move(before, now, tuple(float(d) for d in range(-45, 46, 3)))
+    assert move[0] == 24.0 and move[3:] == (30, 50)
+    assert (moved(before, move) == now).all()
+    slid = best_move(before, now, (0.0,))
+    assert (moved(before, slid) & ~now).sum() > 40  # the corners a slide leaves overhanging

@@ -84,10 +84,13 @@ from vcage.assets.catalog import CATALOG, ObjectType
 from vcage.critics.base import CRITICS, Critic, CriticConfig, Observation, Verdict, View
 from vcage.critics.masks import (
     TOUCH,
+    Move,
+    best_move,
     best_shift,
     centroid_in,
     dilate,
     hull,
+    moved,
     rectangle_sides,
     rows_of,
     shift,
@@ -103,6 +106,9 @@ MIN_OVERLAP = 0.6  # share of the smaller region's (by hull) pixels that must ov
 CENTRE_TOL = 2  # pixels (about 1 cm) by which an object's centre may lie outside its support's hull
 COVERED = 0.5  # share of its top-view area before below which an object counts as covered now
 STILL = 0.9  # share of an object's pixels within its outline before for it to count as not moved
+# Degrees an object pushed along may have turned, tried when following it (see :func:`_not_down`): a
+# basket dragged by a cup stuck to its side turned 16 degrees as it went
+TURNS = tuple(float(d) for d in range(-45, 46, 3))
 ROW_TOL = 3  # pixels of slack for row comparisons in the front view
 AREA_RATIO = (0.8, 1.25)  # top-view (orthographic) area after / before of an object that stayed upright
 SHAPE_RATIO = 1.2  # top-view long-axis spread after / before (either way) of an object that stayed upright
@@ -318,10 +324,10 @@ def _landed_on_other(obs: Observation, top: View, a: str, b: str, inside: bool) 
     - ``a`` rests on ``b``'s rim (see :func:`_on_rim`).
     - ``a`` lies over another object ``c`` whose top stood more than :data:`SUPPORT_TOL` above that
       surface (:data:`THIN_SUPPORT` under most of ``a``'s outline): before the subtask the top view
-      showed ``c`` where ``a`` is seen now, and ``c`` is still there (followed if it was pushed; one
-      that stayed shows less of itself than before, not a neighbour nudged against ``a``; one the
-      table shows through where it stood, beside ``a``, is gone), so ``a`` lies above ``c`` and
-      cannot be down on ``b``.
+      showed ``c`` where ``a`` is seen now, and ``c`` is still there (followed if it was pushed,
+      turned as well as slid, see :data:`TURNS`; one that stayed shows less of itself than before,
+      not a neighbour nudged against ``a``; one the table shows through where it stood, beside
+      ``a``, is gone), so ``a`` lies above ``c`` and cannot be down on ``b``.
       Not asked of ``a`` leaning in ``b``: it may lean against ``c`` standing in ``b`` (a loaf on
       a cup that stood in the basket, its lower end on the floor); its lower end decides.
     """
@@ -473,18 +479,23 @@ def _not_down(obs: Observation, top: View, a: str, surface: float | None, floor:
             continue
         now = top.segmentation == i
         pushed = now.any() and (now & dilate(was, TOUCH)).sum() < STILL * now.sum()
-        dr, dc = best_shift(was, now) if pushed else (0, 0)  # pushed: follow it
-        outline = shift(was, dr, dc)
+        move: Move = (0.0, 0.0, 0.0, *(best_shift(was, now) if pushed else (0, 0)))  # pushed: follow it
+        outline = moved(was, move)
         under = outline & ma & ~dilate(now, 1)
         # where ``c`` stayed, ``a`` hides of it what it no longer shows: nudged a pixel or two (not
         # followed), it still shows all of itself, and the sliver of its outline under ``a`` is not ``c``
         hidden = int(under.sum()) if pushed else min(int(under.sum()), int(was.sum()) - int(now.sum()))
+        if pushed and hidden >= UNDER_PX:  # it may have turned as it went: a slid outline overhangs it
+            move = best_move(was, now, TURNS)
+            outline = moved(was, move)
+            under = outline & ma & ~dilate(now, 1)
+            hidden = int(under.sum())
         if hidden < UNDER_PX:
             continue
         beside = outline & ~dilate(ma, 1)  # where ``c`` would show if it still lay under ``a``
         if (beside & (top.segmentation == BARE)).sum() > beside.sum() / 2:
             continue  # the table shows there: ``c`` is gone (knocked off, out of sight)
-        rise = float(np.median(shift(np.where(was, hb, 0.0), dr, dc)[under])) - surface
+        rise = float(np.median(moved(np.where(was, hb, 0.0), move)[under])) - surface
         if rise > SUPPORT_TOL or (rise > THIN_SUPPORT and under.sum() >= MIN_OVERLAP * ma.sum()):
             return f"{a} lies over {c}, whose top is {100 * rise:.1f} cm above {where}"
     return too_tall

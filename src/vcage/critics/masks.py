@@ -68,6 +68,47 @@ def best_shift(before: np.ndarray, now: np.ndarray) -> tuple[int, int]:
     return (int(r) if r < h else int(r) - 2 * h), (int(c) if c < w else int(c) - 2 * w)
 
 
+Move = tuple[float, float, float, int, int]  # degrees turned about (row, column), then rows and columns
+
+
+def turned(values: np.ndarray, row: float, col: float, deg: float) -> np.ndarray:
+    """``values`` turned ``deg`` degrees about the pixel (``row``, ``col``), each pixel taking its
+    nearest source pixel; what comes from outside the image is zero."""
+    if deg == 0:
+        return values.copy()
+    h, w = values.shape
+    rr, cc = np.mgrid[0:h, 0:w]
+    t = np.radians(deg)
+    sr = np.rint(row + np.cos(t) * (rr - row) + np.sin(t) * (cc - col)).astype(int)
+    sc = np.rint(col - np.sin(t) * (rr - row) + np.cos(t) * (cc - col)).astype(int)
+    inside = (sr >= 0) & (sr < h) & (sc >= 0) & (sc < w)
+    out = np.zeros_like(values)
+    out[inside] = values[sr[inside], sc[inside]]
+    return out
+
+
+def best_move(before: np.ndarray, now: np.ndarray, turns: tuple[float, ...]) -> Move:
+    """The turn (one of ``turns``, degrees, about ``before``'s centre) and translation that lay
+    ``before`` over the most of ``now``'s pixels."""
+    rows, cols = np.nonzero(before)
+    row, col = float(rows.mean()), float(cols.mean())
+    best: tuple[int, Move] | None = None
+    for deg in turns:
+        mask = turned(before, row, col, deg)
+        dr, dc = best_shift(mask, now)
+        score = int((shift(mask, dr, dc) & now).sum())
+        if best is None or score > best[0]:
+            best = score, (deg, row, col, dr, dc)
+    assert best is not None, "no turns to try"
+    return best[1]
+
+
+def moved(values: np.ndarray, move: Move) -> np.ndarray:
+    """``values`` turned and translated by ``move`` (see :func:`best_move`)."""
+    deg, row, col, dr, dc = move
+    return shift(turned(values, row, col, deg), dr, dc)
+
+
 def rows_of(mask: np.ndarray) -> tuple[int, int] | None:
     rows = np.nonzero(mask.any(axis=1))[0]
     return (int(rows[0]), int(rows[-1])) if len(rows) else None
