@@ -92,11 +92,19 @@ def best_move(before: np.ndarray, now: np.ndarray, turns: tuple[float, ...]) -> 
     ``before`` over the most of ``now``'s pixels."""
     rows, cols = np.nonzero(before)
     row, col = float(rows.mean()), float(cols.mean())
+    # search in the window that holds ``now`` and ``before`` turned any way (the same translations)
+    reach = int(np.ceil(np.hypot(rows - row, cols - col).max())) + 1
+    now_rows, now_cols = np.nonzero(now)
+    r0 = max(0, min(int(row) - reach, int(now_rows.min(initial=before.shape[0]))))
+    r1 = max(int(row) + reach + 1, int(now_rows.max(initial=0)) + 1)
+    c0 = max(0, min(int(col) - reach, int(now_cols.min(initial=before.shape[1]))))
+    c1 = max(int(col) + reach + 1, int(now_cols.max(initial=0)) + 1)
+    window, target = before[r0:r1, c0:c1], now[r0:r1, c0:c1]
     best: tuple[int, Move] | None = None
     for deg in turns:
-        mask = turned(before, row, col, deg)
-        dr, dc = best_shift(mask, now)
-        score = int((shift(mask, dr, dc) & now).sum())
+        mask = turned(window, row - r0, col - c0, deg)
+        dr, dc = best_shift(mask, target)
+        score = int((shift(mask, dr, dc) & target).sum())
         if best is None or score > best[0]:
             best = score, (deg, row, col, dr, dc)
     assert best is not None, "no turns to try"
