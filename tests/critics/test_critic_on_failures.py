@@ -301,7 +301,6 @@ def test_a_cup_moved_onto_the_middle_of_a_coaster_it_half_hid_is_on_it() -> None
     assert verdict.accept, verdict.reason
 
 
-
 def test_a_cup_put_on_the_coaster_beside_a_basket_pushed_and_turned_is_on_it() -> None:
     """A Vanilla rollout dragged the basket along with the cup and turned it 16 degrees. Followed by a
     translation only, the basket's outline before overhangs it at two corners, one of them under the
@@ -313,6 +312,7 @@ def test_a_cup_put_on_the_coaster_beside_a_basket_pushed_and_turned_is_on_it() -
                                 moved=(O("basket", "basket", (0.71, 0.142), yaw=0.5),))
     assert oracle
     assert verdict.accept, verdict.reason
+
 
 SEAL_MAT = (O("seal", "seal", (0.5, -0.12)), O("mat", "stamp_mat", (0.58, 0.1)))
 
