@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from vcage.critics.base import Observation, View
-from vcage.critics.image import ImageCritic
+from vcage.critics.image import TURNS, ImageCritic
 from vcage.critics.masks import best_move, moved
 from vcage.pipeline.verifier import render_views
 from vcage.planning.goals import put_at, put_on
@@ -255,7 +255,7 @@ def test_an_outline_is_followed_through_a_turn_as_well_as_a_slide() -> None:
     before[40:60, 30:70] = True  # 20 by 40 pixels
     rows, cols = np.nonzero(before)
     now = moved(before, (24.0, float(rows.mean()), float(cols.mean()), 30, 50))
-    move = best_move(before, now, tuple(float(d) for d in range(-45, 46, 3)))
+    move = best_move(before, now, TURNS)
     assert move[0] == 24.0 and move[3:] == (30, 50)
     assert (moved(before, move) == now).all()
     slid = best_move(before, now, (0.0,))

@@ -481,14 +481,15 @@ def _not_down(obs: Observation, top: View, a: str, surface: float | None, floor:
         pushed = now.any() and (now & dilate(was, TOUCH)).sum() < STILL * now.sum()
         move: Move = (0.0, 0.0, 0.0, *(best_shift(was, now) if pushed else (0, 0)))  # pushed: follow it
         outline = moved(was, move)
-        under = outline & ma & ~dilate(now, 1)
+        bare_a = ma & ~dilate(now, 1)  # what of ``a`` does not border what shows of ``c``
+        under = outline & bare_a
         # where ``c`` stayed, ``a`` hides of it what it no longer shows: nudged a pixel or two (not
         # followed), it still shows all of itself, and the sliver of its outline under ``a`` is not ``c``
         hidden = int(under.sum()) if pushed else min(int(under.sum()), int(was.sum()) - int(now.sum()))
         if pushed and hidden >= UNDER_PX:  # it may have turned as it went: a slid outline overhangs it
             move = best_move(was, now, TURNS)
             outline = moved(was, move)
-            under = outline & ma & ~dilate(now, 1)
+            under = outline & bare_a
             hidden = int(under.sum())
         if hidden < UNDER_PX:
             continue
