@@ -38,12 +38,21 @@ it runs where a GPU is (``--device cuda``; ``--budget SECONDS`` first times a sh
 runs at once and picks the largest multiple of 1,000 steps that fits, the same for every run;
 ``--export DIR`` writes each final checkpoint for evaluation only, with the run's timings);
 ``evaluate --import DIR`` puts such checkpoints in place and rolls them out.
+
+A full run takes longer than a working session may last, and a work folder may not survive between
+sessions. ``--ledger DIR`` keeps what a finished task measured (its results, label noise, failure
+kinds, held-out scenes and loss curves) in one small JSON file per task, stamped with a fingerprint
+of the code (the package's files, this script, the libraries' versions) and the settings: a later
+run with the same ledger skips the tasks it holds (and refuses to add tasks from other code or
+settings), and ``--stage report --ledger DIR`` prints the table and draws the curves from the
+ledger alone, so one table can be assembled over several sessions from one commit.
 """
 
 from __future__ import annotations
 
 import argparse
 import functools
+import hashlib
 import json
 import os
 import re
@@ -441,8 +450,11 @@ def main() -> None:
     parser.add_argument("--fit", type=int, default=10,
                         help="also roll out each checkpoint on this many of its own training scenes (0: no)")
     parser.add_argument("--bootstrap", type=int, default=2000)
-    parser.add_argument("--stage", choices=("all", "data", "train", "evaluate"), default="all",
-                        help="run one stage only (see the module's help); default: all three")
+    parser.add_argument("--stage", choices=("all", "data", "train", "evaluate", "report"), default="all",
+                        help="run one stage only (see the module's help); default: all three; 'report': "
+                        "the table from --ledger alone")
+    parser.add_argument("--ledger", type=Path, default=None,
+                        help="one JSON file per finished task: skip the tasks it holds, add those finished")
     parser.add_argument("--device", default="cpu", help="training device: cpu, or cuda on a GPU machine")
     parser.add_argument("--cuda-graph", action="store_true",
                         help="with --device cuda: capture each run's training step as a CUDA graph")
@@ -467,21 +479,44 @@ def main() -> None:
         args.obs = None
     tasks = args.tasks or list(SUITE)
     t0 = time.perf_counter()
+    if args.stage == "report":
+        if args.ledger is None:
+            raise SystemExit("--stage report reads the table from --ledger DIR: name the folder")
+        report_ledger(args.ledger, tasks, args.bootstrap)
+        return
     if args.stage == "train":
         train_stage(tasks, args)
         print(f"\n{len(tasks)} tasks, {args.train_seeds} training seeds, policy {args.policy} ({args.steps} "
               f"steps) on {args.device}; {time.perf_counter() - t0:.0f} s")
         return
-    results, noise = [], {}
+    results: list[dict[str, Any]] = []
+    noise: dict[str, float] = {}
+    curves_of: dict[tuple[str, str, int], tuple[list[int], list[float]]] = {}
+    stamp = ledger_stamp(args) if args.ledger is not None else None
     for task in tasks:
         print(f"{task}:", flush=True)
+        reuse = args.ledger is not None and args.stage == "all"
+        entry = read_entry(args.ledger, task, stamp) if reuse else None
+        if entry is not None:
+            print(f"  from the ledger ({args.ledger / ledger_name(task)})", flush=True)
+            results += entry["results"]
+            noise[task] = entry["noise"]
+            curves_of |= entry_curves(entry)
+            continue
         datasets, scenes, noise[task] = data_stage(task, args)
-        if args.stage != "data":
-            results += evaluate_stage(task, args, datasets, scenes)
+        if args.stage == "data":
+            continue
+        done = evaluate_stage(task, args, datasets, scenes)
+        results += done
+        curves_of |= {(task, m, s): c for m in METHODS for s in range(args.train_seeds)
+                      if (c := loss_curve(run_dir(args.work, task, m, s))) is not None}
+        if args.ledger is not None and stamp is not None:
+            write_entry(args.ledger, task, stamp, noise[task], failure_kinds(datasets["vanilla"]), scenes,
+                        done, curves_of)
     if args.stage == "data":
         return
     report(results, noise, args.bootstrap)
-    curves = plot_curves(args.work, tasks, args.train_seeds, args.work / "learning_curves.png")
+    curves = plot_curves(curves_of, tasks, args.work / "learning_curves.png")
     if curves is not None:
         print(f"\nlearning curves: {curves}")
     found = (re.search(r"step-(\d+)", str(r["checkpoint"])) for r in results)
@@ -525,44 +560,160 @@ def failure_kinds(dataset: Path) -> dict[str, int]:
     return dict(counts.most_common())
 
 
-def plot_curves(work: Path, tasks: list[str], train_seeds: int, path: Path) -> Path | None:
-    """Each run's training loss (a moving mean over 1% of its steps), per task, V-CAGE against
-    Vanilla, into ``path`` (PNG); None when no run has a checkpoint."""
+def loss_curve(run: Path, points: int = 200) -> tuple[list[int], list[float]] | None:
+    """The run's training loss as a moving mean over 1% of its steps, at about ``points`` steps
+    (None when the run has no checkpoint)."""
+    from vcage.policy.checkpoint import latest_checkpoint, load_checkpoint
+
+    latest = latest_checkpoint(run)
+    if latest is None:
+        return None
+    loss = np.asarray(load_checkpoint(latest)["loss_history"], dtype=float)
+    width = max(1, len(loss) // 100)
+    smooth = np.convolve(loss, np.ones(width) / width, mode="valid")
+    at = np.unique(np.linspace(0, len(smooth) - 1, min(points, len(smooth))).round().astype(int))
+    return [int(i) + width for i in at], [float(smooth[i]) for i in at]
+
+
+def plot_curves(curves: dict[tuple[str, str, int], tuple[list[int], list[float]]], tasks: list[str],
+                path: Path) -> Path | None:
+    """Each run's loss curve (:func:`loss_curve`), per task, V-CAGE against Vanilla, into ``path``
+    (PNG); None when there is no curve."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from vcage.policy.checkpoint import latest_checkpoint, load_checkpoint
-
+    if not curves:
+        return None
     fig, axes = plt.subplots(1, len(tasks), figsize=(3.2 * len(tasks), 2.8), squeeze=False)
-    drawn = False
     for ax, task in zip(axes[0], tasks, strict=True):
         for method, colour in zip(METHODS, ("tab:blue", "tab:orange"), strict=True):
-            for seed in range(train_seeds):
-                latest = latest_checkpoint(run_dir(work, task, method, seed))
-                if latest is None:
-                    continue
-                loss = np.asarray(load_checkpoint(latest)["loss_history"], dtype=float)
-                width = max(1, len(loss) // 100)
-                smooth = np.convolve(loss, np.ones(width) / width, mode="valid")
-                ax.plot(np.arange(len(smooth)) + width, smooth, color=colour, lw=1,
-                        ls=("-", "--", ":")[seed % 3], label=f"{method} seed {seed}")
-                drawn = True
+            for (t, m, seed), (steps, loss) in sorted(curves.items()):
+                if (t, m) == (task, method):
+                    ax.plot(steps, loss, color=colour, lw=1, ls=("-", "--", ":")[seed % 3],
+                            label=f"{method} seed {seed}")
         ax.set_yscale("log")
         ax.set_title(task if len(task) <= 28 else task[:26] + "...", fontsize=8)
         ax.set_xlabel("training step", fontsize=8)
         ax.tick_params(labelsize=7)
     axes[0][0].set_ylabel("denoising loss", fontsize=8)
     axes[0][0].legend(fontsize=6)
-    if not drawn:
-        plt.close(fig)
-        return None
     fig.tight_layout()
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path, dpi=110)
     plt.close(fig)
     return path
+
+
+LEDGER_FORMAT = 1
+# the settings a table's rows must share (the rest, such as --workers or --threads, change no result)
+SETTINGS = ("demos", "eval", "train_seeds", "policy", "action", "obs", "subtask_conditioned", "n_obs_steps",
+            "obs_stride", "steps", "lr", "batch_size", "down_dims", "checkpoint_every", "max_steps", "seed",
+            "size", "eval_batch", "fit")
+
+
+def code_fingerprint() -> str:
+    """A digest of what the results depend on: the vcage package's files, this script, and the versions
+    of the libraries (simulator, solvers, torch)."""
+    from importlib.metadata import version
+
+    import vcage
+    from vcage.provenance import software
+
+    digest = hashlib.sha256()
+    root = Path(vcage.__file__).parent
+    for path in sorted(p for p in root.rglob("*") if p.is_file() and "__pycache__" not in p.parts):
+        digest.update(path.relative_to(root).as_posix().encode() + b"\0" + path.read_bytes())
+    digest.update(Path(__file__).read_bytes())
+    digest.update(json.dumps(software() | {"torch": version("torch")}, sort_keys=True).encode())
+    return digest.hexdigest()[:16]
+
+
+def ledger_stamp(args: argparse.Namespace) -> dict[str, Any]:
+    """What a ledger entry must share with a run that reuses it."""
+    return {"format": LEDGER_FORMAT, "code": code_fingerprint(),
+            "settings": {k: getattr(args, k) for k in SETTINGS}}
+
+
+def ledger_name(task: str) -> str:
+    return f"{slug(task)}.json"
+
+
+def read_entry(ledger: Path, task: str, stamp: dict[str, Any] | None) -> dict[str, Any] | None:
+    """The ledger's entry for ``task`` (None when it has none); with ``stamp``, refused unless it was
+    made by the same code with the same settings."""
+    path = ledger / ledger_name(task)
+    if not path.is_file():
+        return None
+    try:
+        entry = dict(json.loads(path.read_text()))
+    except json.JSONDecodeError as e:
+        raise SystemExit(f"{path} is not a ledger entry ({e}): remove it to run the task again") from e
+    if entry.get("task") != task or entry.get("format") != LEDGER_FORMAT:
+        raise SystemExit(f"{path} is not this ledger's entry for {task!r}: remove it to run the task again")
+    if stamp is not None:
+        differs = [k for k in ("code", "settings") if entry[k] != stamp[k]]
+        if differs:
+            raise SystemExit(f"{path} was made with other {' and '.join(differs)} than this run "
+                             f"({entry['code']} vs {stamp['code']}): one table comes from one code and one "
+                             "set of settings; use another ledger, or run from the code that made it")
+    return entry
+
+
+def write_entry(ledger: Path, task: str, stamp: dict[str, Any], noise: float, kinds: dict[str, int],
+                scenes: list[int], results: list[dict[str, Any]],
+                curves: dict[tuple[str, str, int], tuple[list[int], list[float]]]) -> Path:
+    """The finished task's entry, written whole (a temporary file renamed over the target)."""
+    from datetime import UTC, datetime
+
+    entry = stamp | {"task": task, "written": datetime.now(UTC).isoformat(timespec="seconds"),
+                     "noise": noise, "failure_kinds": kinds, "scenes": scenes, "results": results,
+                     "curves": [{"method": m, "train_seed": s, "steps": c[0], "loss": c[1]}
+                                for (t, m, s), c in sorted(curves.items()) if t == task]}
+    ledger.mkdir(parents=True, exist_ok=True)
+    path = ledger / ledger_name(task)
+    partial = path.with_suffix(".json.partial")
+    partial.write_text(json.dumps(entry, indent=1))
+    partial.replace(path)
+    print(f"  ledger: {path}", flush=True)
+    return path
+
+
+def entry_curves(entry: dict[str, Any]) -> dict[tuple[str, str, int], tuple[list[int], list[float]]]:
+    return {(entry["task"], c["method"], int(c["train_seed"])): (c["steps"], c["loss"])
+            for c in entry["curves"]}
+
+
+def report_ledger(ledger: Path, tasks: list[str], draws: int) -> None:
+    """The table and curves of the ledger's entries for ``tasks``, which must share code and settings;
+    a table short of tasks says so first."""
+    entries = [e for t in tasks if (e := read_entry(ledger, t, None)) is not None]
+    if not entries:
+        raise SystemExit(f"{ledger} holds none of the tasks {tasks}")
+    stamps = {json.dumps({k: e[k] for k in ("code", "settings")}, sort_keys=True) for e in entries}
+    if len(stamps) > 1:
+        raise SystemExit(f"{ledger}: its entries come from {len(stamps)} different codes or settings; one "
+                         "table comes from one")
+    missing = [t for t in tasks if t not in {e["task"] for e in entries}]
+    first = entries[0]
+    print(f"ledger {ledger}: code {first['code']}, {len(entries)} of {len(tasks)} tasks, written "
+          f"{min(e['written'] for e in entries)} to {max(e['written'] for e in entries)}")
+    if missing:
+        print(f"PARTIAL: not in the ledger yet: {', '.join(missing)}")
+    print("settings: " + ", ".join(f"{k}={v}" for k, v in first["settings"].items()))
+    for e in entries:
+        kinds = e["failure_kinds"]
+        if kinds:
+            print(f"{e['task']}: what the oracle finds wrong in Vanilla's demos: "
+                  + ", ".join(f"{what} in {n}" for what, n in kinds.items()))
+    report([r for e in entries for r in e["results"]], {e["task"]: e["noise"] for e in entries}, draws)
+    curves: dict[tuple[str, str, int], tuple[list[int], list[float]]] = {}
+    for e in entries:
+        curves |= entry_curves(e)
+    path = plot_curves(curves, [e["task"] for e in entries], ledger / "learning_curves.png")
+    if path is not None:
+        print(f"\nlearning curves: {path}")
 
 
 def train_stage(tasks: list[str], args: argparse.Namespace) -> None:

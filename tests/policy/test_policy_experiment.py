@@ -117,3 +117,30 @@ def test_subtask_gaps_count_the_episodes_past_each_subtask(capsys: object) -> No
     assert first[-5:-2] == ["4/8", "1/8", "+37.5%"]  # V-CAGE past the first, Vanilla past it, the gap
     assert second[-5:-2] == ["1/8", "0/8", "+12.5%"]
     assert "one step" not in out  # a single subtask has nothing to add to the success rate
+
+
+def test_a_ledger_carries_finished_tasks_across_work_folders_and_refuses_mixing(tmp_path: Path) -> None:
+    """A finished task's entry survives its work folder: a later run reads it back instead of generating,
+    training and evaluating again, the report stage prints the same table from it alone, and an entry
+    made by other code or settings is refused rather than put in one table with this run's."""
+    ledger = tmp_path / "ledger"
+    first = run(tmp_path / "work1", "--ledger", str(ledger))
+    entry = json.loads((ledger / "press_the_bell.json").read_text())
+    assert entry["task"] == "press the bell" and len(entry["results"]) == 2 and len(entry["curves"]) == 2
+    assert entry["settings"]["steps"] == 4 and len(entry["code"]) == 16
+    table = first.split("task ")[1].split("\n\n")[0]
+    again = run(tmp_path / "work2", "--ledger", str(ledger))  # a new work folder: nothing made again
+    assert "from the ledger" in again and "attempts this run" not in again
+    assert not (tmp_path / "work2" / "data").exists()
+    assert again.split("task ")[1].split("\n\n")[0] == table
+    reported = run(tmp_path / "work3", "--stage", "report", "--ledger", str(ledger))
+    assert reported.split("task ")[1].split("\n\n")[0] == table and "PARTIAL" not in reported
+    assert (ledger / "learning_curves.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    partial = run(tmp_path / "work3", "--stage", "report", "--ledger", str(ledger),
+                  "--tasks", "press the bell", "stack the blocks")
+    assert "PARTIAL: not in the ledger yet: stack the blocks" in partial
+    other = run(tmp_path / "work4", "--ledger", str(ledger), "--lr", "0.002", ok=False)
+    assert "made with other settings" in other
+    (ledger / "press_the_bell.json").write_text(json.dumps(entry | {"code": "0" * 16}))
+    refused = run(tmp_path / "work4", "--ledger", str(ledger), ok=False)
+    assert "made with other code" in refused and not (tmp_path / "work4" / "data").exists()
