@@ -1,4 +1,5 @@
-"""Real failed rollouts for critic tests: a small scene, one subtask, a fault injected into its skill.
+"""Real failed rollouts for critic tests: a small scene, one subtask, a fault injected into its skill;
+or one of Vanilla's episodes of a benchmark goal, as ``benchmarks/critic_agreement.py`` rolls it out.
 
 The subtask runs in MuJoCo through the pipeline's own rollout and verifier (views rendered before,
 during and after it); nothing is teleported. Returns what the critic saw and the oracle's values.
@@ -9,9 +10,12 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from vcage.critics.base import Critic, Observation, Verdict
-from vcage.pipeline.episode import Timing
+from vcage.pipeline.config import GenerateConfig
+from vcage.pipeline.episode import Timing, attempt
 from vcage.pipeline.rollout import SubtaskOutcome, run_plan
 from vcage.pipeline.verifier import Verifier
+from vcage.planning import make_planner
+from vcage.planning.goals import GOALS
 from vcage.planning.schema import Plan, PlanObject, Subtask
 from vcage.scene.compose import compose
 from vcage.scene.spec import ObjectSpec, SceneSpec
@@ -62,3 +66,16 @@ def run(objects: tuple[ObjectSpec, ...], subtask: Subtask, fault: str | None = N
     assert len(rollout.outcomes) == len(plan.subtasks) and outcome.skill_error is None, outcome.skill_error
     assert all(o.oracle_success for o in rollout.outcomes[:-1]), rollout.outcomes
     return Run(keep.seen[-1], outcome, injector is None or injector.applied)
+
+
+def vanilla(goal: str, episode: int) -> list[tuple[Observation, SubtaskOutcome]]:
+    """What the critic was shown of each judged subtask of Vanilla's episode ``episode`` of ``goal``
+    (naive placement and no scene check: the plan's objects may start fused into one another), and
+    the subtask's outcome; the rollout goes on whatever the critic says."""
+    plan = make_planner("offline").plan(next(g for g in GOALS if g.name == goal).phrasings[0])
+    cfg = GenerateConfig.vanilla(seed=0)
+    keep = Keep()
+    result = attempt(plan, cfg.episode_seed(episode, 0), cfg, keep)
+    assert result.rollout is not None, result
+    judged = [o for o in result.rollout.outcomes if o.verdict is not None]
+    return list(zip(keep.seen, judged, strict=True))

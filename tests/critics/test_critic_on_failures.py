@@ -13,7 +13,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from critics.faulted import Run, run
+from critics.faulted import Run, run, vanilla
 from vcage.assets.catalog import CATALOG
 from vcage.critics.base import Verdict, View
 from vcage.critics.image import ROBOT, ImageCritic, _peak, _relief
@@ -411,6 +411,34 @@ def test_a_loaf_bridging_the_baskets_rims_is_not_inside_it() -> None:
     assert not oracle
     assert not verdict.accept, "a loaf on the rims was accepted"
     assert "cm under basket's rim: it rests on the rim" in verdict.reason, verdict.reason
+
+
+@pytest.mark.parametrize(("goal", "episode", "index", "why"), [
+    ("set_the_table", 912, 1, "bread's centre lies 2.4 cm in from basket's outline"),
+    ("prepare_breakfast", 858, 0, "the centre of bread's lower end lies 0.7 cm outside"),
+], ids=["level", "leaning"])
+def test_a_loaf_carried_across_the_baskets_wall_is_not_inside_it(goal: str, episode: int, index: int,
+                                                                  why: str) -> None:
+    """Vanilla's naive placement sinks loaves 2-3 cm into the basket's wall, and a fused pair moves as
+    one. Put in, these came to rest across the wall (the oracle: not inside): one lying level with
+    its centre 2.4 cm in from the basket's outline, where a loaf within the walls keeps half its
+    width (2.8 cm at its smallest scale) in; one leaning, its lower end outside the basket. Most of
+    each lies over the basket from the top and no higher than the rim allows: every other check
+    passed them."""
+    obs, outcome = vanilla(goal, episode)[index]
+    assert outcome.oracle == {"inside(bread, basket)": False, "released(bread)": True}
+    verdict = CRITIC.judge(obs)
+    assert verdict.details["checks"] == {"inside(bread, basket)": False, "released(bread)": True}
+    assert why in verdict.reason and "across basket's wall" in verdict.reason, verdict.reason
+
+
+def test_a_loaf_lying_level_against_the_baskets_wall_is_inside_it() -> None:
+    """Dropped over the wall, a loaf comes to rest on the floor against its inside: its centre lies
+    as near the basket's outline as a loaf in the basket can (4.1 cm in), and it is inside."""
+    oracle, verdict = _set_down(BREAD_BASKET, put_in("bread", "basket", "the bread is in the basket"),
+                                O("bread", "bread", (0.58, 0.185), z=0.76), (1.0, 0.0, 0.0, 0.0))
+    assert oracle
+    assert verdict.accept, verdict.reason
 
 
 def test_a_block_set_diagonally_off_centre_on_a_block_is_on_it() -> None:

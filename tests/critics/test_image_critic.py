@@ -7,7 +7,7 @@ import pytest
 
 from vcage.critics.base import Observation, View
 from vcage.critics.image import TURNS, ImageCritic
-from vcage.critics.masks import best_move, moved
+from vcage.critics.masks import best_move, inward, moved
 from vcage.pipeline.verifier import render_views
 from vcage.planning.goals import put_at, put_on
 from vcage.planning.schema import Predicate, Subtask
@@ -260,3 +260,16 @@ def test_an_outline_is_followed_through_a_turn_as_well_as_a_slide() -> None:
     assert (moved(before, move) == now).all()
     slid = best_move(before, now, (0.0,))
     assert (moved(before, slid) & ~now).sum() > 40  # the corners a slide leaves overhanging
+
+
+def test_inward_measures_a_centre_from_the_outline_of_a_region() -> None:
+    """``inward``: how far the centre of a mask lies in from a region's hull, in pixels (minus how far
+    out, outside it)."""
+    region = np.zeros((100, 100), dtype=bool)
+    region[20:80, 10:90] = True
+    blob = np.zeros_like(region)
+    blob[28:33, 40:45] = True  # centre (30, 42): 10 rows below the region's top edge
+    assert inward(blob, region) == pytest.approx(11.0, abs=1.0)
+    outside = np.zeros_like(region)
+    outside[8:13, 40:45] = True  # centre (10, 42): 10 rows above it
+    assert inward(outside, region) == pytest.approx(-10.0, abs=1.0)

@@ -27,9 +27,12 @@ simulator state. Each predicate is checked in image space:
   container, where its top view shows it turned or its top slopes as a leaning object's does, its
   longest side above the rim). In a container its underside, its own height (seen on the table
   before) under its top, or under its top's lower end where it leans, lies below the rim (not
-  resting on it). In a drawer (a placement that comes out with a joint) the drawer is still open
-  after the subtask, and ``a`` lies over what came out of ``b`` (not on its body), below the
-  drawer's rim, and no lower than lying on the drawer's floor makes it.
+  resting on it), and its centre lies in from ``b``'s outline at least as far as ``b``'s region for
+  the oracle does and, lying level, at least half ``a``'s smallest side (leaning, its lower end's
+  centre lies over the region): a loaf lying across the wall is not in. In a drawer (a placement
+  that comes out with a joint) the drawer is still open after the subtask, and ``a`` lies over what
+  came out of ``b`` (not on its body), below the drawer's rim, and no lower than lying on the
+  drawer's floor makes it.
 - ``released(a)``: after the retreat, the robot does not touch ``a`` in every view that shows it
   (a projection overlap in one view is not contact); ``a`` hidden in every view is not released.
 - ``pressed(x)``: in the views at the subtask's deepest moment the robot touches ``x`` (front view,
@@ -90,6 +93,7 @@ from vcage.critics.masks import (
     centroid_in,
     dilate,
     hull,
+    inward,
     moved,
     rectangle_sides,
     rows_of,
@@ -654,9 +658,51 @@ def _inside(obs: Observation, a: str, b: str) -> tuple[bool, str]:
     ok, why = _rests_on(obs, a, b, inside=True)
     otype = _type_of(obs, b)
     drawer = next((p for p in otype.placements if p.kind == "in" and p.joint), None) if otype else None
-    if not ok or drawer is None:
+    if not ok:
         return ok, why
+    if drawer is None:
+        off = _off_centre(obs, a, b)
+        return (False, off) if off is not None else (ok, why)
     return _in_drawer(obs, a, b, drawer)
+
+
+def _off_centre(obs: Observation, a: str, b: str) -> str | None:
+    """Why ``a`` lies too near ``b``'s outline, in the top view after the subtask, to be in ``b``
+    (None if it does not, or the views or types cannot tell). The oracle wants ``a``'s centre of
+    mass over ``b``'s region, which lies in from ``b``'s outline by at least ``b``'s size less the
+    region (its narrower margin, at ``b``'s smallest scale). Lying level within ``b``'s walls, ``a``
+    keeps its centre at least half its smallest side (at its smallest scale) in from them: however
+    turned, it spans that much on either side. A loaf fused into the basket's wall and dragged out
+    with it lies across the wall, its centre 1-3 cm in from the outline, where loaves the oracle
+    counts in lie 4 cm and more in (Vanilla rollouts). Leaning (its top slopes more than
+    :data:`LEVEL`), ``a`` may rest against the rim with its upper end beyond it: there its lower end
+    (the quarter of its top lowest on its plane, as in :func:`_on_rim`), which rests on ``b``'s
+    floor, must lie over the region."""
+    top = obs.after.get(TOP)
+    atype, btype = _type_of(obs, a), _type_of(obs, b)
+    if top is None or top.pixel_size is None or atype is None or btype is None:
+        return None
+    place = next((p for p in btype.placements if p.kind == "in"), None)
+    ma, mb = _mask(obs, top, a), _outline(obs, top, b)
+    if place is None or not ma.any() or not mb.any():
+        return None
+    margin = min(btype.size[0] / 2 - place.half_size[0], btype.size[1] / 2 - place.half_size[1])
+    need = margin * btype.scale_range[0]
+    part, what = ma, f"{a}'s centre"
+    fit = _plane(top, ma)
+    if fit is not None and fit[2] > LEVEL:
+        plane = fit[1]
+        part = np.zeros_like(ma)
+        part[_inner(ma)] = plane <= np.percentile(plane, 25)
+        what = f"the centre of {a}'s lower end"
+    else:
+        need = max(need, min(atype.size) * atype.scale_range[0] / 2)
+    depth = inward(part, mb) * top.pixel_size
+    if depth >= need:
+        return None
+    where = f"{100 * depth:.1f} cm in from" if depth >= 0 else f"{-100 * depth:.1f} cm outside"
+    return (f"{what} lies {where} {b}'s outline, where in {b} it would lie at least {100 * need:.1f} cm "
+            f"in: it lies across {b}'s wall or outside it")
 
 
 def _released(obs: Observation, a: str) -> tuple[bool, str]:

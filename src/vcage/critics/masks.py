@@ -150,3 +150,17 @@ def centroid_in(mask: np.ndarray, region: np.ndarray, tol: int) -> bool:
     rows, cols = np.nonzero(mask)
     r, c = int(round(float(rows.mean()))), int(round(float(cols.mean())))
     return bool(dilate(hull(region), tol)[r, c])
+
+
+def inward(mask: np.ndarray, region: np.ndarray) -> float:
+    """How far (pixels) the centre of ``mask``'s pixels lies inside ``region``'s hull: its distance
+    to the nearest pixel outside the hull; outside it, minus its distance to the nearest pixel in it."""
+    rows, cols = np.nonzero(mask)
+    r, c = float(rows.mean()), float(cols.mean())
+    inner = hull(region)
+    within = bool(inner[int(round(r)), int(round(c))])
+    other = np.argwhere(~inner if within else inner)
+    if not len(other):  # the hull fills the view, or is empty
+        return float(max(inner.shape)) if within else -float(max(inner.shape))
+    d = float(np.min(np.hypot(other[:, 0] - r, other[:, 1] - c)))
+    return d if within else -d
