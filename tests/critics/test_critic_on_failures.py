@@ -432,6 +432,31 @@ def test_a_loaf_carried_across_the_baskets_wall_is_not_inside_it(goal: str, epis
     assert why in verdict.reason and "across basket's wall" in verdict.reason, verdict.reason
 
 
+@pytest.mark.parametrize(("goal", "episode", "off"), [
+    ("build_a_tower", 883, "2.0 cm off"),
+    ("set_the_table", 863, "1.4 cm off"),
+])
+def test_a_bell_left_leaning_where_it_was_fused_is_not_upright(goal: str, episode: int, off: str) -> None:
+    """Vanilla's naive placement sinks the bell into a neighbour, and it stands tilted beyond the
+    oracle's 0.2 rad before its press and after it: its outline and its height did not change, so
+    only where its button lies over its base tells (the hand pressed it: the press itself passes)."""
+    obs, outcome = vanilla(goal, episode)[2]
+    assert outcome.oracle == {"pressed(bell)": True, "upright(bell)": False}
+    verdict = CRITIC.judge(obs)
+    assert verdict.details["checks"] == {"pressed(bell)": True, "upright(bell)": False}
+    assert f"bell's button lies {off} the centre of its base" in verdict.reason, verdict.reason
+
+
+def test_a_bell_leaning_less_than_the_oracles_bound_is_upright() -> None:
+    """A bell fused into a neighbour leans a little (its button 0.7 cm off its base's centre, under
+    the 1.1 cm a tilt of 0.2 rad gives at its smallest scale): the oracle counts it upright, and so
+    does the critic."""
+    obs, outcome = vanilla("prepare_breakfast", 902)[2]
+    assert outcome.oracle == {"pressed(bell)": True, "upright(bell)": True}
+    verdict = CRITIC.judge(obs)
+    assert verdict.accept, verdict.reason
+
+
 def test_a_loaf_lying_level_against_the_baskets_wall_is_inside_it() -> None:
     """Dropped over the wall, a loaf comes to rest on the floor against its inside: its centre lies
     as near the basket's outline as a loaf in the basket can (4.1 cm in), and it is inside."""

@@ -52,7 +52,9 @@ simulator state. Each predicate is checked in image space:
   spread of its outline are close to what they were before, allowing for what the robot can hide;
   its highest point (the top view's depth; without it, its front-view height) did not drop, and
   stands no higher than its type's height at the largest scale allows unless something stands
-  under it (a bell that lay tipped before the subtask too).
+  under it (a bell that lay tipped before the subtask too), and, for a round object with its press
+  point on its axis (a bell's button), that point (its top) lies over the centre of its outline
+  within what a tilt of the oracle's bound allows (a bell left leaning where it stood before).
 - ``hanging(a, b)``: from the top view, ``a``'s highest point stands higher than ``a`` reaches
   resting any way up (its longest side, at its type's largest scale) and ``a`` touches ``b``.
 - ``facing(x)``: the short axis of ``x``'s tall part from the top (a board's plate, a fan's head)
@@ -118,6 +120,16 @@ AREA_RATIO = (0.8, 1.25)  # top-view (orthographic) area after / before of an ob
 SHAPE_RATIO = 1.2  # top-view long-axis spread after / before (either way) of an object that stayed upright
 UPRIGHT_TOL = 0.005  # metres an upright object's top may stand beyond its type's height range
 HEIGHT_RATIO = 0.8  # highest point (front view without depth: height) after / before, stayed upright
+# upright: the oracle's bound on an upright object's tilt (radians). A round object with its press
+# point on its axis (a bell's button) is judged by where that point lies over its base (see
+# :func:`_tipped_axis`) where its outline shows whole, at least WHOLE_BASE of its base's disc at its
+# smallest scale (a neighbour hiding part of it moves its centre), and its top, the pixels within
+# :data:`TOP_BAND` of its highest point, is a button: BUTTON_PX pixels (bells read 11-17; a stray
+# pixel or a flat top is not one). Vanilla rollouts (episodes 810-971), where judged: bells the oracle
+# counted upright read the button at most 0.79 cm off the centre, tilted ones 1.20-1.96 cm
+UPRIGHT_TILT = 0.2
+WHOLE_BASE = 0.9
+BUTTON_PX = (8, 24)
 # How far (metres) the top of an object that ``a`` lies over may stand above ``b``'s surface (the
 # oracle's tolerance for "on"), and how far above what resting on ``b`` allows ``a``'s lowest top-view
 # point may stand (half of it: the bound allows the oracle's 2 cm, but on 270 successes of the
@@ -998,7 +1010,7 @@ def _upright(obs: Observation, x: str) -> tuple[bool, str]:
         was, now = (_highest(h, m) for h, m in ((hb, mb), (ha, ma)))
         if now < HEIGHT_RATIO * was:
             return False, f"{x}'s top stands x{now / max(was, 1e-9):.2f} as high as before (tipped over?)"
-        off = _off_height(obs, after, x, now)
+        off = _off_height(obs, after, x, now) or _tipped_axis(obs, after, x)
         if off is not None:
             return False, off
         return True, "upright"
@@ -1024,6 +1036,43 @@ def _off_height(obs: Observation, top: View, x: str, high: float) -> str | None:
             and _not_down(obs, top, x, None, 0.0, "the table", (x,)) is None:
         return f"{x}'s top is {100 * high:.1f} cm above the table, higher than {x} standing reaches (tipped?)"
     return None
+
+
+def _tipped_axis(obs: Observation, top: View, x: str) -> str | None:
+    """Why ``x`` stands tilted by more than :data:`UPRIGHT_TILT` (None if it does not, or the view or
+    its type cannot tell), from where its top lies over its base. Only for a type with a round base
+    (size x equal to size y) whose press point lies on its axis at its top (a bell's button): upright,
+    that point lies over the centre of the base, which the orthographic top view sees as the centre
+    of ``x``'s outline; tilted by an angle, it lies off it by its height times the sine (at least
+    1.1 cm for a bell at 0.2 rad). Left alone where the outline shows less than :data:`WHOLE_BASE`
+    of the base's disc, or the top is not a button's patch (see :data:`BUTTON_PX`). What it judges
+    is how ``x`` stands, not how it came to: a bell left leaning on a neighbour it was fused with
+    before the subtask stands tilted after it too."""
+    otype = _type_of(obs, x)
+    heights = _heights(top)
+    if otype is None or heights is None or top.pixel_size is None or otype.size[0] != otype.size[1]:
+        return None
+    point = next((p for p in otype.functional_points if p.joint), None)
+    if point is None or point.pos[:2] != (0, 0) or point.pos[2] != otype.size[2]:
+        return None
+    mask = _mask(obs, top, x)
+    if not mask.any():
+        return None
+    lo = otype.scale_range[0]
+    outline = hull(mask)
+    if outline.sum() * top.pixel_size ** 2 < WHOLE_BASE * np.pi * (otype.size[0] / 2 * lo) ** 2:
+        return None
+    patch = mask & (heights >= _peak(heights, mask) - TOP_BAND)
+    if not BUTTON_PX[0] <= patch.sum() <= BUTTON_PX[1]:
+        return None
+    (r, c), (rc, cc) = np.argwhere(patch).mean(axis=0), np.argwhere(outline).mean(axis=0)
+    off = float(np.hypot(r - rc, c - cc)) * top.pixel_size
+    bound = float(np.sin(UPRIGHT_TILT)) * point.pos[2] * lo
+    if off <= bound:
+        return None
+    return (f"{x}'s {point.name} lies {100 * off:.1f} cm off the centre of its base from the top, where "
+            f"standing within {UPRIGHT_TILT} rad of upright it lies at most {100 * bound:.1f} cm off: "
+            "it tilts")
 
 
 def _on_table(obs: Observation, a: str) -> tuple[bool, str]:
