@@ -280,6 +280,29 @@ def test_a_cup_lying_on_its_side_over_a_coaster_it_hides_is_not_on_it() -> None:
     assert not verdict.accept and "lies on its side" in verdict.reason, verdict.reason
 
 
+@pytest.mark.parametrize("episode", [816, 958])
+def test_a_cup_that_never_stood_on_the_table_lying_on_its_side_is_not_on_the_coaster(episode: int) -> None:
+    """Vanilla's naive placement fused these cups into the basket, so no view saw them stand on the
+    table and their height says nothing of their scale; carried out, they came to lie on their sides
+    on the coaster (the oracle: not on it). From the top they show their outer wall, not their inside:
+    their top falls 1.5 cm to their lowest, where lying on its side a cup's falls at most its radius."""
+    obs, outcome = vanilla("set_the_table", episode)[0]
+    assert outcome.oracle == {"on(cup, coaster)": False, "released(cup)": True}
+    verdict = CRITIC.judge(obs)
+    assert verdict.details["checks"] == {"on(cup, coaster)": False, "released(cup)": True}
+    assert "cup shows no inside from the top" in verdict.reason, verdict.reason
+
+
+def test_a_cup_tilted_on_the_coaster_showing_its_inside_is_on_it() -> None:
+    """A Vanilla rollout left the cup leaning on the coaster against the basket it started fused with
+    (the oracle: on it, the base's centre over the coaster). From the top its inside still shows, its
+    top falling 6 cm to its lowest: it does not lie on its side."""
+    obs, outcome = vanilla("set_the_table", 945)[0]
+    assert outcome.oracle == {"on(cup, coaster)": True, "released(cup)": True}
+    verdict = CRITIC.judge(obs)
+    assert verdict.accept, verdict.reason
+
+
 def test_a_cup_standing_on_the_coaster_is_on_it_whatever_its_scale() -> None:
     """The side check reads the cup's scale from its height before: a small cup standing on the
     coaster is not taken for a large one lying down."""

@@ -20,8 +20,9 @@ simulator state. Each predicate is checked in image space:
   as does one whose type declares a domed top (a mouse) and whose top is far flatter than that
   (not a cube: it rests on any face), and one taller than wide whose top is now nearer its height
   lying on a side than its height standing (read before, on the table; where it did not stand there,
-  the bounds its type's scales allow) lies on its side (neither asked in a container, where it may
-  lie any way up; the side is asked also where ``a`` hides ``b``). Put down, ``a``'s top (an open
+  the bounds its type's scales allow) lies on its side, and so does a deep open container (a cup)
+  whose top view, showing most of it, does not show its inside (neither asked in a container, where
+  it may lie any way up; the side is asked also where ``a`` hides ``b``). Put down, ``a``'s top (an open
   container's: its rim, at its outline) stands no higher than its type's height above that surface
   (on a surface that leans, a stand's ramp, its longest side across tilted with the ramp; in a
   container, where its top view shows it turned or its top slopes as a leaning object's does, its
@@ -182,6 +183,12 @@ FOOTPRINT = (0.6, 1.15)
 # on its side: metres by which an object's height standing must exceed its top lying on a side (its
 # longest side across) for the top view's heights to tell the two (a cup: 2 cm at scale 1)
 SIDE_GAP = 0.01
+# ... and an open container (a cup) lies on its side when its inside does not show (see
+# :func:`_no_inside`): of its inner pixels, this percentile is read as its lowest. Vanilla rollouts
+# (episodes 810-971): cups on their sides fell 1.2-3.1 cm from their tops, cups the oracle counted on
+# the coaster (standing, or tilted and still showing their inside) 6.0 cm and more
+HOLLOW_PERCENTILE = 10
+DEEP = 1.5
 # facing: the oracle's tolerance (radians); the tall part's long/short spread; the front view's
 # luminance P90/P10 over the object's upper part above which its detailed face shows to the front
 # camera (plain backs measured 1.0-1.9, a board's code and a fan's grille 4.5 and more); the fewest
@@ -436,6 +443,9 @@ def _on_its_side(obs: Observation, top: View, a: str, b: str) -> str | None:
     now, mb = _mask(obs, top, a), _mask(obs, before, b)
     if not now.any() or not mb.any():
         return None
+    hollow = _no_inside(otype, top, a, now, ha) if _open(otype) else None
+    if hollow is not None:
+        return hollow
     standing, lying = _standing_and_lying(obs, otype, before, a)
     surface = _surface(obs, b, _peak(hb, mb))
     if standing - lying < SIDE_GAP or surface is None:
@@ -445,6 +455,31 @@ def _on_its_side(obs: Observation, top: View, a: str, b: str) -> str | None:
         return (f"{a}'s top is {100 * high:.1f} cm above {b}'s surface, {100 * standing:.1f} cm standing "
                 f"and {100 * lying:.1f} cm lying: it lies on its side")
     return None
+
+
+def _no_inside(otype: ObjectType, top: View, a: str, mask: np.ndarray, heights: np.ndarray) -> str | None:
+    """Why ``a``, an open container (a cup), lies on its side (None if its top view shows its inside,
+    or shows too little of it to tell). Standing on its base, or leaning, it shows its inside from the
+    top: its inner pixels reach down from its rim by about its depth. Lying on its side it shows its
+    outer wall, whose curve falls from its top to its outline by at most its radius (half its width
+    at its largest scale). Judged for a container deep enough that standing it reads far more (its
+    depth at its smallest scale at least :data:`DEEP` times that radius: a cup, a mug, a pen holder;
+    not a bowl, a basket or a box), where its top view covers at least what it covers standing (the
+    lower :data:`FOOTPRINT` share of its footprint at its smallest scale): a cup mostly hidden may show
+    only its wall. Unlike the heights of :func:`_on_its_side`, this needs no height seen before (a cup
+    fused into the basket at the start, and carried so, never stood on the table)."""
+    lo, hi = otype.scale_range
+    radius = min(otype.size[0], otype.size[1]) / 2 * hi
+    depth = (otype.size[2] - otype.placements[0].pos[2]) * lo
+    footprint = otype.size[0] * otype.size[1] * lo ** 2
+    if (depth < DEEP * radius or top.pixel_size is None
+            or mask.sum() * top.pixel_size ** 2 < FOOTPRINT[0] * footprint):
+        return None
+    drop = _highest(heights, mask, rim=True) - float(np.percentile(heights[_inner(mask)], HOLLOW_PERCENTILE))
+    if drop >= radius:
+        return None
+    return (f"{a} shows no inside from the top (its top falls {100 * drop:.1f} cm to its lowest, lying on "
+            f"its side at most {100 * radius:.1f} cm): it lies on its side")
 
 
 def _standing_and_lying(obs: Observation, otype: ObjectType, before: View, a: str) -> tuple[float, float]:
