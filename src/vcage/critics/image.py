@@ -387,8 +387,8 @@ def _on_rim(obs: Observation, top: View, a: str, b: str,
     rim's height is read from all of ``b``'s pixels (at the :data:`RIM_PERCENTILE`): a thin wall
     may be one pixel wide, with no inner pixel. ``lean``: the plane fitting ``a``'s top (see
     :func:`_plane`) where its slope says ``a`` leans (a loaf with one end on the floor and the other
-    against the rim): its lowest point lies under the top's lower end (the quarter of its pixels
-    lowest on that plane), and ``a`` is thicker upright through a point by the slope's secant."""
+    against the rim): its lowest point lies under the top's lower end (see :func:`_lower_end`), and
+    ``a`` is thicker upright through a point by the slope's secant."""
     before = obs.before.get(TOP)
     hb, ha = (_heights(before), _heights(top)) if before is not None else (None, None)
     if before is None or hb is None or ha is None:
@@ -400,7 +400,7 @@ def _on_rim(obs: Observation, top: View, a: str, b: str,
     rim = float(np.percentile(hb[mb], RIM_PERCENTILE))
     if lean is not None:
         heights, plane, slope = lean
-        low_end = float(np.percentile(heights[plane <= np.percentile(plane, 25)], 95))
+        low_end = float(np.percentile(heights[_lower_end(plane)], 95))
         under = rim - (low_end - own * float(np.hypot(1.0, slope)))
     else:
         under = rim - (_highest(ha, now) - own)
@@ -424,6 +424,12 @@ def _own_height(obs: Observation, a: str, outline: bool = False) -> float | None
     if not was.any() or ring.sum() < UNDER_PX or float(np.median(hb[ring])) > HEIGHT_TOL:
         return None
     return _highest(hb, was, rim=outline)
+
+
+def _lower_end(plane: np.ndarray) -> np.ndarray:
+    """Which of a leaning object's inner pixels make its lower end: the quarter of them lowest on the
+    plane fitting its top (``plane``: that plane's heights at them, see :func:`_plane`)."""
+    return plane <= np.percentile(plane, 25)
 
 
 def _on_its_side(obs: Observation, top: View, a: str, b: str) -> str | None:
@@ -723,8 +729,7 @@ def _off_centre(obs: Observation, a: str, b: str) -> str | None:
     with it lies across the wall, its centre 1-3 cm in from the outline, where loaves the oracle
     counts in lie 4 cm and more in (Vanilla rollouts). Leaning (its top slopes more than
     :data:`LEVEL`), ``a`` may rest against the rim with its upper end beyond it: there its lower end
-    (the quarter of its top lowest on its plane, as in :func:`_on_rim`), which rests on ``b``'s
-    floor, must lie over the region."""
+    (see :func:`_lower_end`), which rests on ``b``'s floor, must lie over the region."""
     top = obs.after.get(TOP)
     atype, btype = _type_of(obs, a), _type_of(obs, b)
     if top is None or top.pixel_size is None or atype is None or btype is None:
@@ -740,7 +745,7 @@ def _off_centre(obs: Observation, a: str, b: str) -> str | None:
     if fit is not None and fit[2] > LEVEL:
         plane = fit[1]
         part = np.zeros_like(ma)
-        part[_inner(ma)] = plane <= np.percentile(plane, 25)
+        part[_inner(ma)] = _lower_end(plane)
         what = f"the centre of {a}'s lower end"
     else:
         need = max(need, min(atype.size) * atype.scale_range[0] / 2)
