@@ -244,6 +244,31 @@ def test_a_mouse_tipped_over_at_a_slant_on_the_pad_is_not_on_it() -> None:
     assert not verdict.accept and "bends" in verdict.reason, verdict.reason
 
 
+@pytest.mark.parametrize(("goal", "episode", "index"), [
+    ("tidy_the_desk", 880, 1),
+    ("get_ready_for_work", 852, 2),
+])
+def test_a_mouse_turned_over_at_a_slant_whose_dome_still_bends_is_not_on_the_pad(goal: str, episode: int,
+                                                                                 index: int) -> None:
+    """Vanilla rollouts left mice turned over at a slant on the pad (2.4 rad) whose tops showed enough
+    of the dome to bend as a dome does and to lie far from a plane: only the plane's slope tells, 0.7
+    where a mouse standing on the level pad slopes at most 0.45."""
+    obs, outcome = vanilla(goal, episode)[index]
+    assert outcome.oracle == {"on(mouse, pad)": False, "released(mouse)": True}
+    verdict = CRITIC.judge(obs)
+    assert verdict.details["checks"] == {"on(mouse, pad)": False, "released(mouse)": True}
+    assert "it lies tipped over at a slant" in verdict.reason, verdict.reason
+
+
+def test_a_mouse_leaning_a_little_on_the_pad_is_on_it() -> None:
+    """A Vanilla rollout left the mouse on the pad a little tilted (its top's plane slopes 0.3): the
+    oracle counts it on the pad, and so does the critic."""
+    obs, outcome = vanilla("tidy_the_desk", 871)[1]
+    assert outcome.oracle == {"on(mouse, pad)": True, "released(mouse)": True}
+    verdict = CRITIC.judge(obs)
+    assert verdict.accept, verdict.reason
+
+
 def test_a_mouse_standing_on_its_end_on_the_pad_is_not_on_it() -> None:
     """Vanilla rollouts left mice standing on an end or propped on clutter on the pad: from the top
     they lie over it, their lowest point is down on it and their top is no flatter than before. Stood

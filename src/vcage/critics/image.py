@@ -17,12 +17,13 @@ simulator state. Each predicate is checked in image space:
   before the subtask and is still there (clutter on the target; a flat one, such as a phone lying on
   the target, where it lay under most of ``a``'s outline); an object that stood on its base with a
   curved top before and shows a flat one now, or a domed one that barely bends now, lies turned over,
-  as does one whose type declares a domed top (a mouse) and whose top is far flatter than that
-  (not a cube: it rests on any face), and one taller than wide whose top is now nearer its height
-  lying on a side than its height standing (read before, on the table; where it did not stand there,
-  the bounds its type's scales allow) lies on its side, and so does a deep open container (a cup)
-  whose top view, showing most of it, does not show its inside (neither asked in a container, where
-  it may lie any way up; the side is asked also where ``a`` hides ``b``). Put down, ``a``'s top (an open
+  as does one whose type declares a domed top (a mouse) and whose top is far flatter than that, or
+  whose top's plane slopes well beyond the surface under it (not a cube: it rests on any face), and
+  one taller than wide whose top is now nearer its height lying on a side than its height standing
+  (read before, on the table; where it did not stand there, the bounds its type's scales allow) lies
+  on its side, and so does a deep open container (a cup) whose top view, showing most of it, does
+  not show its inside (neither asked in a container, where it may lie any way up; the side is asked
+  also where ``a`` hides ``b``). Put down, ``a``'s top (an open
   container's: its rim, at its outline) stands no higher than its type's height above that surface
   (on a surface that leans, a stand's ramp, its longest side across tilted with the ramp; in a
   container, where its top view shows it turned or its top slopes as a leaning object's does, its
@@ -176,6 +177,10 @@ MIN_RELIEF_PX = 12
 # at least 0.93 as much
 DOME_FIT = 0.5
 FLAT_BEND = 0.6
+# ... or the plane fitting such a top (see :func:`_slanted_dome`) slopes (rise over run) more than this
+# beyond the surface under it: mice the oracle found on the pad, whole in the top view, sloped at most
+# 0.31; mice turned over at a slant (2.4-2.6 rad) 0.66-1.06 (Vanilla rollouts, episodes 810-971)
+DOME_SLOPE = 0.45
 # ... judged only for an object that stood on its base before: its top-view area between these shares
 # of its type's footprint (size x by size y, times its smallest and largest scale squared); a round
 # or rounded object covers about 0.8 of it
@@ -322,7 +327,8 @@ def _rests_on(obs: Observation, a: str, b: str, inside: bool) -> tuple[bool, str
         return False, f"the centre of {a} is not over {b} from the top"
     # in a container an object may lie any way up; on a surface, turned over it does not rest on its base
     other = _landed_on_other(obs, top, a, b, inside) or (
-        None if inside else _turned_over(obs, top, a) or _on_its_side(obs, top, a, b))
+        None if inside else _turned_over(obs, top, a) or _slanted_dome(obs, top, a, b)
+        or _on_its_side(obs, top, a, b))
     if other is not None:
         return False, other
     fa, fb = rows_of(_mask(obs, front, a)), rows_of(_mask(obs, front, b) | _mask(obs, front, a))
@@ -608,6 +614,30 @@ def _turned_over(obs: Observation, top: View, a: str) -> str | None:
         return (f"{a}'s top is flat ({1000 * now:.1f} mm from a plane; {otype.name} standing shows at least "
                 f"{1000 * flat / TYPE_FLAT:.1f} mm): it lies turned over")
     return why
+
+
+def _slanted_dome(obs: Observation, top: View, a: str, b: str) -> str | None:
+    """Why ``a``, of a type that declares a domed top (``top_relief``: a mouse), does not rest on its
+    base on ``b`` (None if it may, or the view cannot tell): the plane fitting its top's heights
+    slopes by more than :data:`DOME_SLOPE` beyond ``b``'s surface. Standing on its base a dome's plane
+    lies as level as what it stands on; turned over at a slant it shows its flat underside tilted (and
+    part of its dome, so neither its relief nor its bend need change much). Judged where the top view
+    shows at least what it covers standing (the lower :data:`FOOTPRINT` share of its footprint at its
+    smallest scale): a dome mostly hidden may show only a slope of its side."""
+    otype, btype = _type_of(obs, a), _type_of(obs, b)
+    if otype is None or not otype.top_relief or top.pixel_size is None:
+        return None
+    mask = _mask(obs, top, a)
+    footprint = otype.size[0] * otype.size[1] * otype.scale_range[0] ** 2
+    fit = _plane(top, mask)
+    if fit is None or mask.sum() * top.pixel_size ** 2 < FOOTPRINT[0] * footprint:
+        return None
+    ramp = btype.placements[0].slope if btype is not None and btype.placements else 0.0
+    bound = float(np.tan(ramp)) + DOME_SLOPE
+    if fit[2] <= bound:
+        return None
+    return (f"{a}'s domed top slopes {fit[2]:.2f} (rise over run), where standing on its base on {b} it "
+            f"slopes at most {bound:.2f}: it lies tipped over at a slant")
 
 
 def _flatter_than_before(obs: Observation, top: View, a: str, otype: ObjectType, before: View,
