@@ -476,16 +476,14 @@ def _no_inside(otype: ObjectType, top: View, a: str, mask: np.ndarray, heights: 
     outer wall, whose curve falls from its top to its outline by at most its radius (half its width
     at its largest scale). Judged for a container deep enough that standing it reads far more (its
     depth at its smallest scale at least :data:`DEEP` times that radius: a cup, a mug, a pen holder;
-    not a bowl, a basket or a box), where its top view covers at least what it covers standing (the
-    lower :data:`FOOTPRINT` share of its footprint at its smallest scale): a cup mostly hidden may show
-    only its wall. Unlike the heights of :func:`_on_its_side`, this needs no height seen before (a cup
-    fused into the basket at the start, and carried so, never stood on the table)."""
+    not a bowl, a basket or a box), where its top view covers at least what it covers standing (see
+    :func:`_shows_most`): a cup mostly hidden may show only its wall. Unlike the heights of
+    :func:`_on_its_side`, this needs no height seen before (a cup fused into the basket at the start,
+    and carried so, never stood on the table)."""
     lo, hi = otype.scale_range
     radius = min(otype.size[0], otype.size[1]) / 2 * hi
     depth = (otype.size[2] - otype.placements[0].pos[2]) * lo
-    footprint = otype.size[0] * otype.size[1] * lo ** 2
-    if (depth < DEEP * radius or top.pixel_size is None
-            or mask.sum() * top.pixel_size ** 2 < FOOTPRINT[0] * footprint):
+    if depth < DEEP * radius or not _shows_most(otype, top, mask):
         return None
     drop = _highest(heights, mask, rim=True) - float(np.percentile(heights[_inner(mask)], HOLLOW_PERCENTILE))
     if drop >= radius:
@@ -622,15 +620,14 @@ def _slanted_dome(obs: Observation, top: View, a: str, b: str) -> str | None:
     slopes by more than :data:`DOME_SLOPE` beyond ``b``'s surface. Standing on its base a dome's plane
     lies as level as what it stands on; turned over at a slant it shows its flat underside tilted (and
     part of its dome, so neither its relief nor its bend need change much). Judged where the top view
-    shows at least what it covers standing (the lower :data:`FOOTPRINT` share of its footprint at its
-    smallest scale): a dome mostly hidden may show only a slope of its side."""
+    shows at least what it covers standing (see :func:`_shows_most`): a dome mostly hidden may show
+    only a slope of its side."""
     otype, btype = _type_of(obs, a), _type_of(obs, b)
     if otype is None or not otype.top_relief or top.pixel_size is None:
         return None
     mask = _mask(obs, top, a)
-    footprint = otype.size[0] * otype.size[1] * otype.scale_range[0] ** 2
     fit = _plane(top, mask)
-    if fit is None or mask.sum() * top.pixel_size ** 2 < FOOTPRINT[0] * footprint:
+    if fit is None or not _shows_most(otype, top, mask):
         return None
     ramp = btype.placements[0].slope if btype is not None and btype.placements else 0.0
     bound = float(np.tan(ramp)) + DOME_SLOPE
@@ -667,6 +664,16 @@ def _on_its_base(otype: ObjectType, view: View, mask: np.ndarray) -> bool:
     lo, hi = otype.scale_range
     share = mask.sum() * view.pixel_size ** 2 / (otype.size[0] * otype.size[1])
     return bool(FOOTPRINT[0] * lo ** 2 <= share <= FOOTPRINT[1] * hi ** 2)
+
+
+def _shows_most(otype: ObjectType, view: View, mask: np.ndarray) -> bool:
+    """Whether ``mask``, an object of type ``otype`` in an orthographic view, covers at least what it
+    covers standing on its base (the lower :data:`FOOTPRINT` share of its footprint at its smallest
+    scale): not mostly hidden."""
+    if view.pixel_size is None:
+        return False
+    footprint = otype.size[0] * otype.size[1] * otype.scale_range[0] ** 2
+    return bool(mask.sum() * view.pixel_size ** 2 >= FOOTPRINT[0] * footprint)
 
 
 def _dome(view: View, mask: np.ndarray) -> tuple[float, float] | None:
