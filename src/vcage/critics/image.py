@@ -921,6 +921,12 @@ def _peak(heights: np.ndarray, mask: np.ndarray) -> float:
     return float(h[kept if kept.any() else inner].max())
 
 
+def _top_band(heights: np.ndarray, mask: np.ndarray) -> np.ndarray:
+    """``mask``'s top in a top view's ``heights``: its pixels within :data:`TOP_BAND` of its highest
+    point (see :func:`_peak`), where a button or lever is."""
+    return mask & (heights >= _peak(heights, mask) - TOP_BAND)
+
+
 def _button_cover(obs: Observation, x: str) -> float | None:
     """Share of ``x``'s top (its pixels within :data:`TOP_BAND` of its highest point before the
     subtask, where a button or lever is) that the robot hides from the top view at the subtask's
@@ -934,7 +940,7 @@ def _button_cover(obs: Observation, x: str) -> float | None:
     mask = _mask(obs, before, x)
     if not mask.any():
         return None
-    top = mask & (hb >= _peak(hb, mask) - TOP_BAND)
+    top = _top_band(hb, mask)
     return float(((during.segmentation == ROBOT) & top).sum() / top.sum())
 
 
@@ -1139,7 +1145,7 @@ def _tipped_axis(obs: Observation, top: View, x: str) -> str | None:
     outline = hull(mask)
     if outline.sum() * top.pixel_size ** 2 < WHOLE_BASE * np.pi * (otype.size[0] / 2 * lo) ** 2:
         return None
-    patch = mask & (heights >= _peak(heights, mask) - TOP_BAND)
+    patch = _top_band(heights, mask)
     if not BUTTON_PX[0] <= patch.sum() <= BUTTON_PX[1]:
         return None
     (r, c), (rc, cc) = np.argwhere(patch).mean(axis=0), np.argwhere(outline).mean(axis=0)
