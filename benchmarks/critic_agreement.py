@@ -47,7 +47,7 @@ os.environ.setdefault("LP_NUM_THREADS", "1")  # one rasteriser thread: a worker 
 
 from obs_cache import cached, fingerprint, open_cache  # noqa: E402
 from vcage.config import MESH_DETAILS, RenderConfig  # noqa: E402
-from vcage.critics import Critic, CriticConfig, Observation, Verdict, make_critic  # noqa: E402
+from vcage.critics import CriticConfig, Observation, Recorder, make_critic  # noqa: E402
 from vcage.pipeline.config import GenerateConfig  # noqa: E402
 from vcage.pipeline.episode import attempt  # noqa: E402
 from vcage.planning import make_planner  # noqa: E402
@@ -56,18 +56,6 @@ from vcage.scene.stability import StabilityConfig  # noqa: E402
 
 DEFAULT_GOALS = ("get_ready_for_work", "prepare_breakfast", "tidy_the_desk", "set_the_table",
                  "build_a_tower", "sort_blocks_by_colour")
-
-
-class Shadow(Critic):
-    """Keeps the observations it is asked about, but always lets the rollout go on."""
-
-    def __init__(self, needs_views: bool) -> None:
-        self.seen: list[Observation] = []
-        self.needs_views = needs_views
-
-    def judge(self, obs: Observation) -> Verdict:
-        self.seen.append(obs)
-        return Verdict(True, "shadow: the rollout continues")
 
 
 Judged = tuple[str, Observation, bool, str, str]  # scene, observation, oracle success, where, oracle
@@ -82,7 +70,7 @@ def _rollout(goal: str, episode: int, mesh_detail: str) -> Episode:
     plan = make_planner("offline").plan(phrase)
     # episode k: the seed of the Vanilla run's episode k
     cfg = GenerateConfig.vanilla(seed=0, render=RenderConfig(mesh_detail=mesh_detail))
-    shadow = Shadow(make_critic(CriticConfig("image")).needs_views)
+    shadow = Recorder(make_critic(CriticConfig("image")).needs_views)
     result = attempt(plan, cfg.episode_seed(episode, 0), cfg, shadow)
     if result.rollout is None:
         return 0.0, []

@@ -48,7 +48,7 @@ import numpy as np  # noqa: E402
 
 from obs_cache import cached, open_cache  # noqa: E402
 from vcage.backends import BackendConfig  # noqa: E402
-from vcage.critics import Critic, CriticConfig, Observation, Verdict, make_critic  # noqa: E402
+from vcage.critics import CriticConfig, Observation, Recorder, Verdict, make_critic  # noqa: E402
 from vcage.critics.base import View  # noqa: E402
 from vcage.critics.vlm import ENV_PREFIX as VLM_ENV  # noqa: E402
 from vcage.errors import VcageError  # noqa: E402
@@ -85,17 +85,6 @@ class Sample:
     obs: Observation
 
 
-class Keep(Critic):
-    """Keeps every observation and lets the rollout go on."""
-
-    def __init__(self) -> None:
-        self.seen: list[Observation] = []
-
-    def judge(self, obs: Observation) -> Verdict:
-        self.seen.append(obs)
-        return Verdict(True, "kept")
-
-
 def _plan(goal: str) -> Plan:
     phrase = next(g for g in GOALS if g.name == goal).phrasings[0]
     return make_planner("offline").plan(phrase)
@@ -123,7 +112,7 @@ def rollout(goal: str, index: int, seed: int, fault: str | None) -> Sample | str
         occurrence = sum(s.skill == sub.skill for s in plan.subtasks[:index])
         injector = FaultInjector(FaultConfig(fault, sub.skill, occurrence, seed))
     skills = Skills(world, Player(world, record_states=True), fault=injector)
-    keep = Keep()
+    keep = Recorder()
     with Renderer(world, *cfg.render.critic_size, cfg.render.mesh_detail) as renderer:
         verifier = Verifier(world, plan, keep, renderer, skills.player.recording, Timing())
         result = run_plan(world, plan, skills, verifier)

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from vcage.critics.base import Critic, Observation, Verdict
+from vcage.critics.base import Observation, Recorder
 from vcage.pipeline.config import GenerateConfig
 from vcage.pipeline.episode import Timing, attempt
 from vcage.pipeline.rollout import SubtaskOutcome, run_plan
@@ -23,17 +23,6 @@ from vcage.sim.render import Renderer
 from vcage.skills.base import Skills
 from vcage.skills.faults import FaultConfig, FaultInjector
 from vcage.skills.playback import Player
-
-
-class Keep(Critic):
-    """Keeps what it was shown; accepts, so the rollout goes on."""
-
-    def __init__(self) -> None:
-        self.seen: list[Observation] = []
-
-    def judge(self, obs: Observation) -> Verdict:
-        self.seen.append(obs)
-        return Verdict(True, "kept")
 
 
 @dataclass
@@ -58,7 +47,7 @@ def run(objects: tuple[ObjectSpec, ...], subtask: Subtask, fault: str | None = N
     assert all(st.skill != subtask.skill for st in before)
     injector = FaultInjector(FaultConfig(fault, subtask.skill, 0, seed)) if fault else None
     skills = Skills(world, Player(world, record_states=True), fault=injector)
-    keep = Keep()
+    keep = Recorder()
     with Renderer(world, 320, 240) as renderer:
         verifier = Verifier(world, plan, keep, renderer, skills.player.recording, Timing())
         rollout = run_plan(world, plan, skills, verifier)
@@ -74,7 +63,7 @@ def vanilla(goal: str, episode: int) -> list[tuple[Observation, SubtaskOutcome]]
     the subtask's outcome; the rollout goes on whatever the critic says."""
     plan = make_planner("offline").plan(next(g for g in GOALS if g.name == goal).phrasings[0])
     cfg = GenerateConfig.vanilla(seed=0)
-    keep = Keep()
+    keep = Recorder()
     result = attempt(plan, cfg.episode_seed(episode, 0), cfg, keep)
     assert result.rollout is not None, result
     judged = [o for o in result.rollout.outcomes if o.verdict is not None]

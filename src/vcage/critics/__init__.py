@@ -4,6 +4,15 @@ Importing the package registers the built-in critics in ``CRITICS``.
 """
 
 from vcage.critics import image, oracle, vlm  # noqa: F401  (register the built-in critics)
-from vcage.critics.base import CRITICS, Critic, CriticConfig, Observation, Verdict, View, make_critic
+from vcage.critics.base import (
+    CRITICS,
+    Critic,
+    CriticConfig,
+    Observation,
+    Recorder,
+    Verdict,
+    View,
+    make_critic,
+)
 
-__all__ = ["CRITICS", "Critic", "CriticConfig", "Observation", "Verdict", "View", "make_critic"]
+__all__ = ["CRITICS", "Critic", "CriticConfig", "Observation", "Recorder", "Verdict", "View", "make_critic"]

@@ -72,6 +72,22 @@ class Critic(ABC):
         nothing to check."""
 
 
+
+class Recorder(Critic):
+    """Accepts every subtask and keeps what it was shown, in order (``seen``): the rollout goes on
+    whatever happened, so a benchmark or a test can judge each observation afterwards, with any
+    critic, beside the oracle's label of the same subtask. Not registered: it judges nothing.
+    ``needs_views``: render the views a critic that needs them would be shown (the default)."""
+
+    def __init__(self, needs_views: bool = True) -> None:
+        self.seen: list[Observation] = []
+        self.needs_views = needs_views
+
+    def judge(self, obs: Observation) -> Verdict:
+        self.seen.append(obs)
+        return Verdict(True, "recorded; the rollout goes on")
+
+
 @dataclass(frozen=True)
 class CriticConfig:
     """Which critic judges each subtask, and its options.
