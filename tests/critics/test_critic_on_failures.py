@@ -31,6 +31,14 @@ from vcage.tasks import predicates as P
 CRITIC = ImageCritic()
 
 
+def _judged_vanilla(goal: str, episode: int, index: int, oracle: dict[str, bool]) -> Verdict:
+    """The critic's verdict on subtask ``index`` of Vanilla's episode ``episode`` of ``goal``, once the
+    oracle's values there are checked to be ``oracle`` (the state the test describes)."""
+    obs, outcome = vanilla(goal, episode)[index]
+    assert outcome.oracle == oracle
+    return CRITIC.judge(obs)
+
+
 def _sub(skill: str, args: dict[str, object], *preds: tuple[str, tuple[str, ...]]) -> Subtask:
     return Subtask(skill=skill, args=args, description="a subtask under test",
                    predicates=tuple(Predicate(name=n, args=a) for n, a in preds))
@@ -253,9 +261,7 @@ def test_a_mouse_turned_over_at_a_slant_whose_dome_still_bends_is_not_on_the_pad
     """Vanilla rollouts left mice turned over at a slant on the pad (2.4 rad) whose tops showed enough
     of the dome to bend as a dome does and to lie far from a plane: only the plane's slope tells, 0.7
     where a mouse standing on the level pad slopes at most 0.45."""
-    obs, outcome = vanilla(goal, episode)[index]
-    assert outcome.oracle == {"on(mouse, pad)": False, "released(mouse)": True}
-    verdict = CRITIC.judge(obs)
+    verdict = _judged_vanilla(goal, episode, index, {"on(mouse, pad)": False, "released(mouse)": True})
     assert verdict.details["checks"] == {"on(mouse, pad)": False, "released(mouse)": True}
     assert "it lies tipped over at a slant" in verdict.reason, verdict.reason
 
@@ -263,9 +269,7 @@ def test_a_mouse_turned_over_at_a_slant_whose_dome_still_bends_is_not_on_the_pad
 def test_a_mouse_leaning_a_little_on_the_pad_is_on_it() -> None:
     """A Vanilla rollout left the mouse on the pad a little tilted (its top's plane slopes 0.3): the
     oracle counts it on the pad, and so does the critic."""
-    obs, outcome = vanilla("tidy_the_desk", 871)[1]
-    assert outcome.oracle == {"on(mouse, pad)": True, "released(mouse)": True}
-    verdict = CRITIC.judge(obs)
+    verdict = _judged_vanilla("tidy_the_desk", 871, 1, {"on(mouse, pad)": True, "released(mouse)": True})
     assert verdict.accept, verdict.reason
 
 
@@ -311,9 +315,7 @@ def test_a_cup_that_never_stood_on_the_table_lying_on_its_side_is_not_on_the_coa
     table and their height says nothing of their scale; carried out, they came to lie on their sides
     on the coaster (the oracle: not on it). From the top they show their outer wall, not their inside:
     their top falls 1.5 cm to their lowest, where lying on its side a cup's falls at most its radius."""
-    obs, outcome = vanilla("set_the_table", episode)[0]
-    assert outcome.oracle == {"on(cup, coaster)": False, "released(cup)": True}
-    verdict = CRITIC.judge(obs)
+    verdict = _judged_vanilla("set_the_table", episode, 0, {"on(cup, coaster)": False, "released(cup)": True})
     assert verdict.details["checks"] == {"on(cup, coaster)": False, "released(cup)": True}
     assert "cup shows no inside from the top" in verdict.reason, verdict.reason
 
@@ -322,9 +324,7 @@ def test_a_cup_tilted_on_the_coaster_showing_its_inside_is_on_it() -> None:
     """A Vanilla rollout left the cup leaning on the coaster against the basket it started fused with
     (the oracle: on it, the base's centre over the coaster). From the top its inside still shows, its
     top falling 6 cm to its lowest: it does not lie on its side."""
-    obs, outcome = vanilla("set_the_table", 945)[0]
-    assert outcome.oracle == {"on(cup, coaster)": True, "released(cup)": True}
-    verdict = CRITIC.judge(obs)
+    verdict = _judged_vanilla("set_the_table", 945, 0, {"on(cup, coaster)": True, "released(cup)": True})
     assert verdict.accept, verdict.reason
 
 
@@ -473,9 +473,7 @@ def test_a_loaf_carried_across_the_baskets_wall_is_not_inside_it(goal: str, epis
     width (2.8 cm at its smallest scale) in; one leaning, its lower end outside the basket. Most of
     each lies over the basket from the top and no higher than the rim allows: every other check
     passed them."""
-    obs, outcome = vanilla(goal, episode)[index]
-    assert outcome.oracle == {"inside(bread, basket)": False, "released(bread)": True}
-    verdict = CRITIC.judge(obs)
+    verdict = _judged_vanilla(goal, episode, index, {"inside(bread, basket)": False, "released(bread)": True})
     assert verdict.details["checks"] == {"inside(bread, basket)": False, "released(bread)": True}
     assert why in verdict.reason and "across basket's wall" in verdict.reason, verdict.reason
 
@@ -488,9 +486,7 @@ def test_a_bell_left_leaning_where_it_was_fused_is_not_upright(goal: str, episod
     """Vanilla's naive placement sinks the bell into a neighbour, and it stands tilted beyond the
     oracle's 0.2 rad before its press and after it: its outline and its height did not change, so
     only where its button lies over its base tells (the hand pressed it: the press itself passes)."""
-    obs, outcome = vanilla(goal, episode)[2]
-    assert outcome.oracle == {"pressed(bell)": True, "upright(bell)": False}
-    verdict = CRITIC.judge(obs)
+    verdict = _judged_vanilla(goal, episode, 2, {"pressed(bell)": True, "upright(bell)": False})
     assert verdict.details["checks"] == {"pressed(bell)": True, "upright(bell)": False}
     assert f"bell's button lies {off} the centre of its base" in verdict.reason, verdict.reason
 
@@ -499,9 +495,7 @@ def test_a_bell_leaning_less_than_the_oracles_bound_is_upright() -> None:
     """A bell fused into a neighbour leans a little (its button 0.7 cm off its base's centre, under
     the 1.1 cm a tilt of 0.2 rad gives at its smallest scale): the oracle counts it upright, and so
     does the critic."""
-    obs, outcome = vanilla("prepare_breakfast", 902)[2]
-    assert outcome.oracle == {"pressed(bell)": True, "upright(bell)": True}
-    verdict = CRITIC.judge(obs)
+    verdict = _judged_vanilla("prepare_breakfast", 902, 2, {"pressed(bell)": True, "upright(bell)": True})
     assert verdict.accept, verdict.reason
 
 
