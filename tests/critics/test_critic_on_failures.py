@@ -244,12 +244,12 @@ def test_a_declared_top_relief_is_what_the_top_view_shows_of_the_type_standing(n
 def test_a_mouse_tipped_over_at_a_slant_on_the_pad_is_not_on_it() -> None:
     """A Vanilla rollout left a mouse on the pad tilted 2.5 rad (this orientation): most of its flat
     underside up, part of its dome showing, so its top lies far enough from a plane (0.46 of its
-    relief before) to pass for a dome. A quadric says more: the dome that bent down before barely
-    bends now."""
+    relief before) to pass the comparison with itself before; but under half as far as the dome its
+    type declares (2.6 mm, where a mouse standing shows 5.4 mm at its smallest scale)."""
     oracle, verdict = _set_down(MOUSE_PAD, put_on("mouse", "pad", "the mouse is on the pad"),
                                 O("mouse", "mouse", (0.583, 0.107), z=0.8), (0.207, -0.625, 0.714, -0.238))
     assert not oracle
-    assert not verdict.accept and "bends" in verdict.reason, verdict.reason
+    assert not verdict.accept and "top is flat (2.6 mm from a plane" in verdict.reason, verdict.reason
 
 
 @pytest.mark.parametrize(("goal", "episode", "index"), [
@@ -272,6 +272,14 @@ def test_a_mouse_leaning_a_little_on_the_pad_is_on_it() -> None:
     verdict = _judged_vanilla("tidy_the_desk", 871, 1, {"on(mouse, pad)": True, "released(mouse)": True})
     assert verdict.accept, verdict.reason
 
+
+
+def test_a_mouse_on_the_pad_whose_dome_bends_less_than_before_is_on_it() -> None:
+    """A Vanilla rollout carried a mouse fused with its neighbours onto the pad, where it stands on its
+    base (the oracle: on it), its top read bending 0.54 as much as before from the top: how much a top
+    bends says nothing of a turn that its plane's slope and relief do not."""
+    verdict = _judged_vanilla("tidy_the_desk", 988, 1, {"on(mouse, pad)": True, "released(mouse)": True})
+    assert verdict.accept, verdict.reason
 
 def test_a_mouse_standing_on_its_end_on_the_pad_is_not_on_it() -> None:
     """Vanilla rollouts left mice standing on an end or propped on clutter on the pad: from the top
