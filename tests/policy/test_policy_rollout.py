@@ -136,6 +136,53 @@ def test_evaluate_rolls_out_every_episode_and_counts_what_the_environment_report
             "per_episode"} <= set(record)
 
 
+
+class LurchingEnv(CountingEnv):
+    """A :class:`CountingEnv` that steps a real MuJoCo world (one block) with each step; in the
+    episodes ``lurch`` the block is flung at 1e6 m/s before step 3, and the world's stability check
+    raises as the env's contract says (a policy driving objects an unchecked scene fused together)."""
+
+    def __init__(self, winners: set[int], lurch: set[int]) -> None:
+        from vcage.scene.compose import compose
+        from vcage.scene.spec import ObjectSpec, SceneSpec
+
+        super().__init__(winners)
+        self.lurch = lurch
+        self.world = compose(SceneSpec(objects=(ObjectSpec("a", "block", (0.5, 0.0)),))).make_world()
+
+    episode_option = True  # starts episode k when asked (options={"episode": k}), as GoalEnv does
+
+    def reset(self, *, seed: int | None = None, options: Any = None) -> Any:
+        self.world.reset()
+        out = super().reset(seed=seed, options=options)
+        self.episode = options["episode"]
+        return out
+
+    def step(self, action: np.ndarray) -> Any:
+        if self.episode in self.lurch and self.t == 2:
+            self.world.data.qvel[self.world.model.joint("a/free").dofadr[0]] = 1e6
+        self.world.step()
+        return super().step(action)
+
+
+@pytest.mark.parametrize("batch", [1, 4])
+def test_an_episode_whose_physics_fails_ends_as_a_failure_and_the_evaluation_goes_on(checkpoint: Path,
+                                                                                     batch: int) -> None:
+    """Episode 1 would succeed but its physics fails at step 3: it counts as a failure that says why,
+    after the steps it took; the episodes around it are rolled out as if it had not happened."""
+
+    def make_env(config: dict[str, Any], *, seed: int, max_steps: int | None = None,
+                 action: str = "action") -> gym.Env:
+        return LurchingEnv({0, 1, 2}, lurch={1})
+
+    result = evaluate(checkpoint, 4, seed=3, make_env=make_env, batch=batch)
+    assert [e.success for e in result.episodes] == [True, False, True, False]
+    assert [e.steps for e in result.episodes] == [10, 3, 10, 12]
+    assert [e.unstable is not None for e in result.episodes] == [False, True, False, False]
+    assert "simulation unstable at t=0.150s: joint 'a/free'" in (result.episodes[1].unstable or "")
+    assert result.unstable == 1 and result.to_dict()["unstable"] == 1
+    assert result.success_rate == 0.5
+
 def test_wilson_intervals_and_subtask_shares() -> None:
     assert wilson_interval(0, 2) == pytest.approx((0.0, 0.6576), abs=1e-4)
     assert wilson_interval(5, 10) == pytest.approx((0.2366, 0.7634), abs=1e-4)

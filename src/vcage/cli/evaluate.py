@@ -101,6 +101,8 @@ def evaluate_cmd(
     table.add_column("")
     table.add_column("value", justify="right")
     table.add_row("success rate", f"{result.success_rate:.1%} ({result.successes}/{len(result.episodes)})")
+    if result.unstable:
+        table.add_row("physics failed (counted as failures)", str(result.unstable))
     table.add_row("Wilson 95% interval", f"[{low:.1%}, {high:.1%}]")
     table.add_row("mean progress", f"{result.mean_progress:.1%}")
     for i, share in enumerate(result.subtask_progress):

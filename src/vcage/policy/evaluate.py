@@ -6,6 +6,11 @@ observation features (names, sizes, element names), action (name and size) and c
 checked against the environment's; a difference raises :class:`EnvironmentMismatchError`. The
 environment is asked for the checkpoint's action (``make_env(..., action=...)``: joint targets, or
 the tool's pose, which it turns into joint targets by IK).
+
+An environment raises :class:`~vcage.errors.SimulationError` where its physics fails (the contract of
+:mod:`vcage.tasks.env`); a policy can drive it there (a lurch into objects an unchecked scene left
+fused together). Such an episode ends as a failure that says so (``EpisodeResult.unstable``, counted
+apart in :attr:`Evaluation.unstable`), and the evaluation goes on: one rollout does not lose the others.
 """
 
 from __future__ import annotations
@@ -13,7 +18,7 @@ from __future__ import annotations
 import functools
 import time
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -21,6 +26,7 @@ import gymnasium as gym
 import numpy as np
 import torch
 
+from vcage.errors import SimulationError
 from vcage.policy.checkpoint import load_checkpoint
 from vcage.policy.config import ACTION
 from vcage.policy.dataset import FeatureSpec
@@ -40,6 +46,7 @@ class EpisodeResult:
     progress: float
     steps: int
     scene_seed: int | None
+    unstable: str | None = None  # why the physics failed, where it ended the episode (a failure)
 
 
 @dataclass(frozen=True)
@@ -59,6 +66,11 @@ class Evaluation:
     @property
     def success_rate(self) -> float:
         return self.successes / len(self.episodes) if self.episodes else 0.0
+
+    @property
+    def unstable(self) -> int:
+        """How many episodes ended because the physics failed (counted as failures)."""
+        return sum(e.unstable is not None for e in self.episodes)
 
     @property
     def interval(self) -> tuple[float, float]:
@@ -81,7 +93,7 @@ class Evaluation:
     def to_dict(self) -> dict[str, Any]:
         low, high = self.interval
         return {"checkpoint": self.checkpoint, "seed": self.seed, "episodes": len(self.episodes),
-                "successes": self.successes, "success_rate": self.success_rate,
+                "successes": self.successes, "success_rate": self.success_rate, "unstable": self.unstable,
                 "wilson95": [low, high], "subtask_progress": self.subtask_progress,
                 "subtask_names": list(self.subtask_names), "mean_progress": self.mean_progress,
                 "seconds": self.seconds, "rollouts_per_minute": self.rollouts_per_minute,
@@ -150,10 +162,12 @@ def rollout_block(runners: Sequence[PolicyRunner], envs: Sequence[gym.Env], seed
     leaves the batch. The outcome of an episode depends only on the block it is in (the others'
     observations change what is computed beside it, not the arithmetic of its own chunk, beyond the
     last bits that a batch's size can change)."""
-    obs = []
+    obs, infos = [], []
     for runner, env, k in zip(runners, envs, episodes, strict=True):
         runner.reset(episode_noise_seed(seed, k))
-        obs.append(env.reset(seed=seed, options={"episode": k})[0])
+        observation, info = env.reset(seed=seed, options={"episode": k})
+        obs.append(observation)
+        infos.append(info)
     results: list[EpisodeResult | None] = [None] * len(episodes)
     steps = [0] * len(episodes)
     live = list(range(len(episodes)))
@@ -161,10 +175,14 @@ def rollout_block(runners: Sequence[PolicyRunner], envs: Sequence[gym.Env], seed
         actions = act_together([runners[i] for i in live], [obs[i] for i in live])
         still = []
         for i, action in zip(live, actions, strict=True):
-            obs[i], _, terminated, truncated, info = envs[i].step(action)
+            try:
+                obs[i], _, terminated, truncated, infos[i] = envs[i].step(action)
+            except SimulationError as exc:
+                results[i] = unstable_result(infos[i], steps[i] + 1, exc)
+                continue
             steps[i] += 1
             if terminated or truncated:
-                results[i] = episode_result(info, steps[i])
+                results[i] = episode_result(infos[i], steps[i])
             else:
                 still.append(i)
         live = still
@@ -193,7 +211,10 @@ def rollout(runner: PolicyRunner, env: gym.Env, seed: int | None = None,
         obs, info = env.reset(seed=seed, options={"episode": episode})
     steps, terminated, truncated = 0, False, False
     while not (terminated or truncated):
-        obs, _, terminated, truncated, info = env.step(runner.act(obs))
+        try:
+            obs, _, terminated, truncated, info = env.step(runner.act(obs))
+        except SimulationError as exc:
+            return unstable_result(info, steps + 1, exc)
         steps += 1
     return episode_result(info, steps)
 
@@ -203,6 +224,12 @@ def episode_result(info: Mapping[str, Any], steps: int) -> EpisodeResult:
     return EpisodeResult(bool(info.get("success", False)), int(info.get("subtasks_done", 0)),
                          int(info.get("subtasks", 1)), float(info.get("progress", 0.0)), steps,
                          info.get("scene_seed"))
+
+
+def unstable_result(info: Mapping[str, Any], steps: int, error: SimulationError) -> EpisodeResult:
+    """A failed episode whose physics failed at step ``steps``; ``info``: the last the environment
+    gave (what it had done before that step)."""
+    return replace(episode_result(info, steps), success=False, unstable=str(error))
 
 
 def training_scenes(checkpoint: Mapping[str, Any], count: int) -> list[int]:

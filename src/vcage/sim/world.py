@@ -82,7 +82,7 @@ class World:
         """Apply ``ctrl`` (if given) and advance one control period; raise if unstable."""
         if ctrl is not None:
             self.data.ctrl[:] = ctrl
-        t0 = time.perf_counter()
+        t0, sim_time = time.perf_counter(), self.data.time
         before = self._bad_state_warnings()
         try:
             mujoco.mj_step(self.model, self.data, nstep=self.substeps)
@@ -92,7 +92,7 @@ class World:
             self.physics_seconds += time.perf_counter() - t0
         if self._bad_state_warnings() > before:  # MuJoCo reset the data after NaN/Inf/huge values
             raise SimulationError(
-                f"simulation unstable near t={self.data.time:.3f}s: MuJoCo found NaN, Inf or huge "
+                f"simulation unstable near t={sim_time:.3f}s: MuJoCo found NaN, Inf or huge "
                 "values in the state and reset it; reduce the timestep or check the scene for "
                 "interpenetrating objects"
             )
