@@ -3,7 +3,8 @@
 A rollout's observations do not depend on the critic that judges them, so a benchmark that stores
 them re-judges a changed critic in seconds. They do depend on everything else (the oracle's labels,
 the skills, the physics, the renderer), so a directory is stamped with a fingerprint of the package
-outside ``vcage/critics`` when first filled, and refused by code with another fingerprint: stale
+outside ``vcage/critics`` (and the layers above the pipeline, ``policy`` and ``cli``, which the
+rollouts cannot import) when first filled, and refused by code with another fingerprint: stale
 rollouts never pass for fresh ones. Each entry is written to a temporary file and renamed into
 place: a run stopped or failing mid-write leaves no truncated entry for the next run to trip on.
 """
@@ -28,13 +29,17 @@ class StaleCache(SystemExit):
     """The cache directory was filled by other code than this checkout's."""
 
 
+NOT_ROLLOUTS = ("critics", "policy", "cli")  # what a stored rollout cannot depend on (import layers)
+
+
 def fingerprint(root: Path | None = None) -> str:
-    """A digest of the package's files outside ``critics/`` (what a stored rollout depends on)."""
+    """A digest of the package's files outside :data:`NOT_ROLLOUTS` (what a stored rollout depends
+    on: the pipeline and the stages below it; the layers contract keeps ``policy`` and ``cli`` out)."""
     root = Path(vcage.__file__).parent if root is None else root
     digest = hashlib.sha256()
     for path in sorted(p for p in root.rglob("*") if p.is_file()):
         rel = path.relative_to(root)
-        if rel.parts[0] == "critics" or "__pycache__" in rel.parts:
+        if rel.parts[0] in NOT_ROLLOUTS or "__pycache__" in rel.parts:
             continue
         digest.update(str(rel).encode() + b"\0" + path.read_bytes())
     return digest.hexdigest()[:16]

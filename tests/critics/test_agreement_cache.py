@@ -98,12 +98,13 @@ def test_a_store_filled_by_other_code_is_refused(tmp_path: Path) -> None:
 
 def test_the_fingerprint_follows_the_package_but_not_its_critics(tmp_path: Path) -> None:
     root = tmp_path / "vcage"
-    (root / "critics").mkdir(parents=True)
-    (root / "tasks").mkdir()
-    (root / "critics" / "image.py").write_text("A = 1\n")
+    for part in ("critics", "tasks", "policy", "cli"):
+        (root / part).mkdir(parents=True)
+        (root / part / "x.py").write_text("A = 1\n")
     (root / "tasks" / "predicates.py").write_text("B = 1\n")
     first = fingerprint(root)
-    (root / "critics" / "image.py").write_text("A = 2\n")
-    assert fingerprint(root) == first
+    for part in ("critics", "policy", "cli"):  # none of them can change a rollout
+        (root / part / "x.py").write_text("A = 2\n")
+        assert fingerprint(root) == first, part
     (root / "tasks" / "predicates.py").write_text("B = 2\n")
     assert fingerprint(root) != first
