@@ -336,6 +336,15 @@ def test_a_cup_tilted_on_the_coaster_showing_its_inside_is_on_it() -> None:
     assert verdict.accept, verdict.reason
 
 
+
+def test_a_cup_whose_height_reads_lying_but_that_shows_its_inside_is_on_the_coaster() -> None:
+    """A Vanilla rollout left the cup standing on the coaster tilted (the oracle: on it), its top
+    8.1 cm above the coaster where it stood 9.8 cm tall and would lie 7.6 cm high: nearer lying than
+    standing. From the top its inside shows (its top falls 7.6 cm to its lowest; lying on its side,
+    at most its radius, 3.9 cm): it does not lie on its side."""
+    verdict = _judged_vanilla("set_the_table", 830, 0, {"on(cup, coaster)": True, "released(cup)": True})
+    assert verdict.accept, verdict.reason
+
 def test_a_cup_standing_on_the_coaster_is_on_it_whatever_its_scale() -> None:
     """The side check reads the cup's scale from its height before: a small cup standing on the
     coaster is not taken for a large one lying down."""

@@ -185,9 +185,11 @@ FOOTPRINT = (0.6, 1.15)
 # longest side across) for the top view's heights to tell the two (a cup: 2 cm at scale 1)
 SIDE_GAP = 0.01
 # ... and an open container (a cup) lies on its side when its inside does not show (see
-# :func:`_no_inside`): of its inner pixels, this percentile is read as its lowest. Vanilla rollouts
-# (episodes 810-971): cups on their sides fell 1.2-3.1 cm from their tops, cups the oracle counted on
-# the coaster (standing, or tilted and still showing their inside) 6.0 cm and more
+# :func:`_inside_fall`), and not when it does, whatever its height says: of its inner pixels, this
+# percentile is read as its lowest. Vanilla rollouts (episodes 810-971): cups on their sides fell
+# 1.2-3.1 cm from their tops, cups the oracle counted on the coaster (standing, or tilted and still
+# showing their inside) 6.0 cm and more; of those whose height alone read lying (episodes 810-1079),
+# 99 on their sides fell 0-2.3 cm, 4 standing 7.6-8.7 cm
 HOLLOW_PERCENTILE = 10
 DEEP = 1.5
 # facing: the oracle's tolerance (radians); the tall part's long/short spread; the front view's
@@ -442,7 +444,9 @@ def _on_its_side(obs: Observation, top: View, a: str, b: str) -> str | None:
     lying height than the standing one lies on its side. A tilted object (a cup leaning on its rim's
     edge) stands at least as high as the lower of the two: a cylinder tipped by an angle reaches its
     height times the cosine plus its diameter times the sine. Objects that carry on any face (cubes)
-    and objects not taller than wide are not judged."""
+    and objects not taller than wide are not judged. An open container whose top view tells whether
+    its inside shows (see :func:`_inside_fall`) is judged by that alone: a cup standing in a tilt its
+    height reads as lying still shows its inside."""
     otype = _type_of(obs, a)
     before = obs.before.get(TOP)
     hb, ha = (_heights(before), _heights(top)) if before is not None else (None, None)
@@ -451,9 +455,13 @@ def _on_its_side(obs: Observation, top: View, a: str, b: str) -> str | None:
     now, mb = _mask(obs, top, a), _mask(obs, before, b)
     if not now.any() or not mb.any():
         return None
-    hollow = _no_inside(otype, top, a, now, ha) if _open(otype) else None
-    if hollow is not None:
-        return hollow
+    fall = _inside_fall(otype, top, now, ha) if _open(otype) else None
+    if fall is not None:  # the top view tells by itself: its inside shows (standing or leaning) or not
+        drop, radius = fall
+        if drop >= radius:
+            return None
+        return (f"{a} shows no inside from the top (its top falls {100 * drop:.1f} cm to its lowest, lying "
+                f"on its side at most {100 * radius:.1f} cm): it lies on its side")
     standing, lying = _standing_and_lying(obs, otype, before, a)
     surface = _surface(obs, b, _peak(hb, mb))
     if standing - lying < SIDE_GAP or surface is None:
@@ -465,9 +473,11 @@ def _on_its_side(obs: Observation, top: View, a: str, b: str) -> str | None:
     return None
 
 
-def _no_inside(otype: ObjectType, top: View, a: str, mask: np.ndarray, heights: np.ndarray) -> str | None:
-    """Why ``a``, an open container (a cup), lies on its side (None if its top view shows its inside,
-    or shows too little of it to tell). Standing on its base, or leaning, it shows its inside from the
+def _inside_fall(otype: ObjectType, top: View, mask: np.ndarray,
+                 heights: np.ndarray) -> tuple[float, float] | None:
+    """How far the top of ``mask``, an open container (a cup) in the top view, falls to its lowest
+    (the :data:`HOLLOW_PERCENTILE` of its inner heights), and the most it falls lying on its side;
+    None where the view cannot tell. Standing on its base, or leaning, it shows its inside from the
     top: its inner pixels reach down from its rim by about its depth. Lying on its side it shows its
     outer wall, whose curve falls from its top to its outline by at most its radius (half its width
     at its largest scale). Judged for a container deep enough that standing it reads far more (its
@@ -482,10 +492,7 @@ def _no_inside(otype: ObjectType, top: View, a: str, mask: np.ndarray, heights: 
     if depth < DEEP * radius or not _shows_most(otype, top, mask):
         return None
     drop = _highest(heights, mask, rim=True) - float(np.percentile(heights[_inner(mask)], HOLLOW_PERCENTILE))
-    if drop >= radius:
-        return None
-    return (f"{a} shows no inside from the top (its top falls {100 * drop:.1f} cm to its lowest, lying on "
-            f"its side at most {100 * radius:.1f} cm): it lies on its side")
+    return drop, radius
 
 
 def _standing_and_lying(obs: Observation, otype: ObjectType, before: View, a: str) -> tuple[float, float]:
