@@ -72,7 +72,6 @@ class Critic(ABC):
         nothing to check."""
 
 
-
 class Recorder(Critic):
     """Accepts every subtask and keeps what it was shown, in order (``seen``): the rollout goes on
     whatever happened, so a benchmark or a test can judge each observation afterwards, with any
