@@ -70,8 +70,8 @@ def _rollout(goal: str, episode: int, mesh_detail: str) -> Episode:
     plan = make_planner("offline").plan(phrase)
     # episode k: the seed of the Vanilla run's episode k
     cfg = GenerateConfig.vanilla(seed=0, render=RenderConfig(mesh_detail=mesh_detail))
-    shadow = Recorder(make_critic(CriticConfig("image")).needs_views)
-    result = attempt(plan, cfg.episode_seed(episode, 0), cfg, shadow)
+    recorder = Recorder(make_critic(CriticConfig("image")).needs_views)
+    result = attempt(plan, cfg.episode_seed(episode, 0), cfg, recorder)
     if result.rollout is None:
         return 0.0, []
     scene = hashlib.sha1(json.dumps(result.scene.to_dict() if result.scene else None, sort_keys=True,
@@ -79,7 +79,7 @@ def _rollout(goal: str, episode: int, mesh_detail: str) -> Episode:
     judged = [o for o in result.rollout.outcomes if o.verdict is not None]
     return max((d for *_, d in result.fused), default=0.0), [
         (scene, obs, o.oracle_success, f"seed {episode} subtask {o.index + 1}", str(o.oracle))
-        for o, obs in zip(judged, shadow.seen, strict=True)]
+        for o, obs in zip(judged, recorder.seen, strict=True)]
 
 
 def _run(job: tuple[str, int, str, str | None]) -> list[Row]:

@@ -136,11 +136,12 @@ def test_evaluate_rolls_out_every_episode_and_counts_what_the_environment_report
             "per_episode"} <= set(record)
 
 
-
 class LurchingEnv(CountingEnv):
     """A :class:`CountingEnv` that steps a real MuJoCo world (one block) with each step; in the
     episodes ``lurch`` the block is flung at 1e6 m/s before step 3, and the world's stability check
     raises as the env's contract says (a policy driving objects an unchecked scene fused together)."""
+
+    episode_option = True  # starts episode k when asked (options={"episode": k}), as GoalEnv does
 
     def __init__(self, winners: set[int], lurch: set[int]) -> None:
         from vcage.scene.compose import compose
@@ -149,8 +150,6 @@ class LurchingEnv(CountingEnv):
         super().__init__(winners)
         self.lurch = lurch
         self.world = compose(SceneSpec(objects=(ObjectSpec("a", "block", (0.5, 0.0)),))).make_world()
-
-    episode_option = True  # starts episode k when asked (options={"episode": k}), as GoalEnv does
 
     def reset(self, *, seed: int | None = None, options: Any = None) -> Any:
         self.world.reset()
@@ -182,6 +181,7 @@ def test_an_episode_whose_physics_fails_ends_as_a_failure_and_the_evaluation_goe
     assert "simulation unstable at t=0.150s: joint 'a/free'" in (result.episodes[1].unstable or "")
     assert result.unstable == 1 and result.to_dict()["unstable"] == 1
     assert result.success_rate == 0.5
+
 
 def test_wilson_intervals_and_subtask_shares() -> None:
     assert wilson_interval(0, 2) == pytest.approx((0.0, 0.6576), abs=1e-4)

@@ -610,7 +610,7 @@ def _turned_over(obs: Observation, top: View, a: str) -> str | None:
         return None
     now = _relief(top, _mask(obs, top, a))
     flat = TYPE_FLAT * otype.top_relief * otype.scale_range[0]
-    why = _flatter_than_before(obs, top, a, otype, before, now)
+    why = _flatter_than_before(obs, a, otype, before, now)
     if why is None and now is not None and now < flat:
         return (f"{a}'s top is flat ({1000 * now:.1f} mm from a plane; {otype.name} standing shows at least "
                 f"{1000 * flat / TYPE_FLAT:.1f} mm): it lies turned over")
@@ -640,7 +640,7 @@ def _slanted_dome(obs: Observation, top: View, a: str, b: str) -> str | None:
             f"slopes at most {bound:.2f}: it lies tipped over at a slant")
 
 
-def _flatter_than_before(obs: Observation, top: View, a: str, otype: ObjectType, before: View,
+def _flatter_than_before(obs: Observation, a: str, otype: ObjectType, before: View,
                          now: float | None) -> str | None:
     """The first reason of :func:`_turned_over` (``now``: the relief of ``a``'s top after)."""
     mask = _mask(obs, before, a)
