@@ -328,16 +328,6 @@ def test_a_cup_that_never_stood_on_the_table_lying_on_its_side_is_not_on_the_coa
     assert "cup shows no inside from the top" in verdict.reason, verdict.reason
 
 
-def test_a_bell_pressed_through_a_loaf_the_hand_still_carries_is_not_pressed() -> None:
-    """The loaf stayed between the fingers after the subtask that was to put it in the basket (the
-    oracle: not released), and the hand pressed the bell with it: the button went down, but the robot
-    never touched the bell (the oracle: not pressed). From the front the loaf hangs from the hand over
-    a third of where the bell showed before; the top view sees only the hand over the button."""
-    verdict = _judged_vanilla("set_the_table", 1137, 2, {"pressed(bell)": False, "upright(bell)": True})
-    assert not verdict.accept
-    assert "the hand pressed bell through bread, which it carried over bell" in verdict.reason, verdict.reason
-
-
 def test_a_cup_tilted_on_the_coaster_showing_its_inside_is_on_it() -> None:
     """A Vanilla rollout left the cup leaning on the coaster against the basket it started fused with
     (the oracle: on it, the base's centre over the coaster). From the top its inside still shows, its

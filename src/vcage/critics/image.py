@@ -49,9 +49,7 @@ simulator state. Each predicate is checked in image space:
   deeper than a full press: ``x`` gave way under the hand (it rocked or fell). Where the hand goes
   down behind an object standing in front of ``x`` (a cup before a bell), or ``x`` does not show in
   the front view at all, the front view cannot show the contact; then the top view's cover and
-  depth, both required, decide. The hand must not carry another object over ``x`` (in the front view,
-  touching the hand where ``x`` showed before: a loaf left between the fingers), which would press
-  ``x`` instead of the robot.
+  depth, both required, decide.
 - ``upright(x)``: ``x``'s top-view area (orthographic, so true to size wherever it stands) and the
   spread of its outline are close to what they were before, allowing for what the robot can hide;
   its highest point (the top view's depth; without it, its front-view height) did not drop, and
@@ -232,13 +230,6 @@ PRESS_ROOM = 0.004
 # metres of its highest point, where the button or lever is) must be this much hidden by the robot
 TOP_BAND = 0.004
 BUTTON_COVER = 0.8
-# Share of the pressed object's front-view outline before the subtask, and pixels at least, that another
-# object touching the hand may show over at the press (where it did not show before) before the hand
-# counts as pressing through what it carries. On Vanilla episodes 1134-1241 the presses the oracle
-# counted had at most 4 pixels so covered (2.5% of a bell in plain view; 25% of one the basket hid but
-# for 16 pixels); the bells pressed through a loaf left between the fingers, 73-117 pixels, 30-43%.
-CARRIED = 0.15
-CARRIED_PX = 20
 # Metres by which a pixel inside an object's outline may stand above all its neighbours there and still
 # be read as the object's top: higher, it is a stray depth reading (one pixel 59 cm above the table
 # was read inside a bell 5 cm tall). A button is several pixels wide and a lever's ridge runs on.
@@ -822,9 +813,6 @@ def _pressed(obs: Observation, x: str) -> tuple[bool, str]:
         return False, f"an object in front hides where the hand met {x}, and the top view cannot measure it"
     if cover is not None and cover < BUTTON_COVER:
         return False, f"the hand covered {cover:.0%} of {x}'s top (its button) at its lowest"
-    carried = _carried_over(obs, x)
-    if carried is not None:
-        return False, f"the hand pressed {x} through {carried}, which it carried over {x}"
     if reading is not None:
         depth, full, share = reading
         if depth < share * full:
@@ -834,29 +822,6 @@ def _pressed(obs: Observation, x: str) -> tuple[bool, str]:
             return False, (f"the hand went {1000 * (depth - full):.1f} mm deeper than a full press of {x}: "
                            f"{x} gave way under it (tipped, slid or fell)")
     return True, "the hand touched and covered it at its lowest"
-
-
-def _carried_over(obs: Observation, x: str) -> str | None:
-    """The object the hand carried over ``x`` at the subtask's deepest moment, if any: in the front view
-    it touches the hand and shows where ``x`` showed before the subtask and it did not, over at least
-    :data:`CARRIED` of ``x``'s outline then (a loaf left between the fingers by the subtask before).
-    What the hand presses through it is not the robot's press: the oracle asks that the robot touch
-    ``x``."""
-    before, during = obs.before.get(FRONT), obs.during.get(FRONT)
-    if before is None or during is None:
-        return None
-    was = _mask(obs, before, x)
-    if not was.any():
-        return None
-    robot = during.segmentation == ROBOT
-    for label, name in enumerate(obs.labels):
-        now = during.segmentation == label
-        if name == x or not now.any():
-            continue
-        over = int((now & was & (before.segmentation != label)).sum())
-        if over >= max(CARRIED * was.sum(), CARRIED_PX) and touch(robot, now, during.depth):
-            return name
-    return None
 
 
 def _contact_hidden(obs: Observation, front: View, x: str) -> bool:
