@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Set up vcage on a fresh Debian machine: GL libraries for offscreen rendering, chromium for the
-# report's browser test, a virtualenv, and the package with its development tools. Safe to run again.
+# report's browser test, a virtualenv, and the package with its development tools, all from
+# requirements/lock.txt (scripts/lock.sh writes it). Safe to run again.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 if command -v apt-get >/dev/null 2>&1 && [ "$(id -u)" = 0 ]; then
@@ -17,7 +18,8 @@ fi
 if [ ! -x .venv/bin/python ]; then
   python3 -m venv .venv
 fi
-.venv/bin/python -m pip install -q --upgrade pip
-# the CPU build of torch (a local wheel here) before anything that depends on it: vcage.policy
-.venv/bin/python -m pip install -q torch==2.13.0
-.venv/bin/python -m pip install -q -e ".[dev]"
+# Everything from the lock file (exact versions, checked against their hashes), so that a release
+# elsewhere cannot change what runs here; then vcage itself, with nothing else resolved.
+.venv/bin/python -m pip install -q pip==26.3
+.venv/bin/python -m pip install -q --require-hashes -r requirements/lock.txt
+.venv/bin/python -m pip install -q --no-deps --no-build-isolation -e .
