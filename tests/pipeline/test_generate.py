@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import shutil
 from dataclasses import replace
 from pathlib import Path
 
@@ -18,9 +19,11 @@ from vcage.pipeline.attempt_log import read
 from vcage.pipeline.audit import audit
 from vcage.pipeline.config import ExecutorConfig, GenerateConfig
 from vcage.pipeline.generate import generate
+from vcage.provenance import software
 from vcage.scene.compose import compose
 from vcage.scene.instantiate import SceneConfig
 from vcage.scene.spec import SceneSpec
+from vcage.scene.stability import StabilityConfig
 from vcage.tasks import predicates as P
 
 SHORT = "press the bell"
@@ -49,6 +52,9 @@ def test_generate_writes_a_verified_dataset(tmp_path: Path) -> None:
     assert seconds["physics"] + seconds["render"] <= stats["wall_seconds"]
     # the versions the episodes depend on (the same seed gives the same episode only under them)
     assert stats["software"]["mujoco"] == mujoco.__version__ and stats["software"]["mink"] != "absent"
+    # and the code: the commit, the package's digest and the lock file's hash, in the run and the episode
+    assert stats["software"] == extras["software"] == software()
+    assert {"commit", "source", "lock"} <= set(extras["software"])
     report = audit(out)
     assert report.accepted == 1 and report.agreement == 1.0 and report.judged_subtasks == 2
 
@@ -143,21 +149,36 @@ def test_vanilla_accepts_without_a_critic(tmp_path: Path) -> None:
     assert audit(out).judged_subtasks == 0
 
 
+def _vanilla_fused(tmp_path: Path, tries: int = 30) -> tuple[int, Path, dict]:
+    """The first run seed whose Vanilla episode of :data:`SHORT` (eight distractors) starts with the
+    bell fused into another object, its dataset and its attempt record: found by the property, not
+    named, so that a release of the simulator that moves which seed does so moves no test."""
+    for seed in range(tries):
+        out = tmp_path / f"vanilla-{seed}"
+        cfg = GenerateConfig.vanilla(seed=seed, clutter=8, render=RenderConfig(size=(64, 64)))
+        generate(SHORT, 1, out, cfg)
+        record = json.loads((out / ATTEMPTS_LOG).read_text().splitlines()[-1])
+        if record["fused_at_start"]:
+            return seed, out, record
+        shutil.rmtree(out)
+    raise AssertionError(f"no Vanilla episode of {tries} seeds started fused: naive placement no longer "
+                         "fuses objects as often as it did (about one scene in three)")
+
+
 def test_a_vanilla_episode_that_starts_fused_says_so_in_its_log_and_audit(tmp_path: Path) -> None:
-    """Naive placement put the bell 2 cm into an alarm clock (seed 6, eight distractors), and
-    settling left them so: the attempt log names the pair and its depth, and the audit counts the
-    accepted episode among those that started fused. A checked scene never starts so."""
-    out = tmp_path / "fused"
-    generate(SHORT, 1, out, GenerateConfig.vanilla(seed=6, clutter=8, render=RenderConfig(size=(64, 64))))
-    record = json.loads((out / ATTEMPTS_LOG).read_text().splitlines()[-1])
-    [(a, b, depth)] = record["fused_at_start"]
-    assert {a, b} == {"bell", "clutter5_alarm_clock"} and depth > 0.01
+    """Naive placement can put the bell into a distractor, and settling leaves them so: the attempt
+    log names the pair and its depth, and the audit counts the accepted episode among those that
+    started fused. A checked scene never starts so."""
+    seed, out, record = _vanilla_fused(tmp_path)
+    for a, b, depth in record["fused_at_start"]:
+        assert "bell" in (a, b) and a != b and depth > StabilityConfig().penetration
     report = audit(out)
+    noise = 0.0 if record["oracle_success"] else 1.0
     assert (report.accepted, report.accepted_fused) == (1, 1)
-    assert report.noise_where(True) == 0.0 and report.noise_where(False) is None
+    assert report.noise_where(True) == noise and report.noise_where(False) is None
     assert "1 of them started with the plan's objects fused" in report.summary()
     checked = tmp_path / "checked"
-    generate(SHORT, 1, checked, GenerateConfig(seed=6, **SMALL))
+    generate(SHORT, 1, checked, GenerateConfig(seed=seed, **SMALL))
     assert json.loads((checked / ATTEMPTS_LOG).read_text().splitlines()[-1])["fused_at_start"] == []
     assert audit(checked).accepted_fused == 0 and "fused" not in audit(checked).summary()
 

@@ -93,9 +93,10 @@ def dataset_card(info: dict[str, Any], tasks: list[str]) -> str:
         f"- `{layout.ATTEMPTS_LOG}`: every attempt, accepted or not, with its stage, reason and "
         "oracle audit.",
         f"- `{layout.RUNS_LOG}`: one line per generation run: its funnel (attempts by stage, time) and the "
-        "versions of the software its episodes depend on (the same seed gives the same episode under them).",
+        "software its episodes depend on: versions, the git commit, a digest of vcage's files and the lock "
+        "file's hash (the same seed gives the same episode under them).",
         f"- `{layout.EXTRAS_PATH.format(episode_index=0).replace('000000', 'NNNNNN')}`: an episode's "
-        "seed, plan, scene, critic verdicts and oracle audit.",
+        "seed, plan, scene, critic verdicts, oracle audit and software.",
         f"- `{layout.ARRAYS_PATH.format(episode_index=0).replace('000000', 'NNNNNN')}`: the simulator "
         "states of an episode, for exact replay.",
         f"- `{layout.CARD_PATH}`: this card, rewritten at each commit.",

@@ -19,6 +19,7 @@ from vcage.pipeline.config import GenerateConfig
 from vcage.pipeline.episode import Attempt, Timing, attempt
 from vcage.pipeline.features import ee_actions, environment_states, frames_of, subtask_indices
 from vcage.planning.schema import Plan
+from vcage.provenance import software
 from vcage.sim.render import Renderer
 
 
@@ -113,6 +114,7 @@ def episode_data(plan: Plan, cfg: GenerateConfig, result: Attempt,
                       "verdict": o.verdict} for o in result.rollout.outcomes],
         "oracle_audit": _audit(result), "oracle_success": result.oracle_success,
         "attempts": list(attempts),
+        "software": software(),
     }
     arrays = {"states": states, "initial_state": np.asarray(result.initial_state)}
     t0 = time.perf_counter()
