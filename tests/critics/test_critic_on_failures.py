@@ -4,6 +4,11 @@ Every image check has a case here where the oracle says its predicate failed aft
 an injected fault (nothing teleported), and the check itself must say so: replacing any check of
 ``IMAGE_CHECKS`` with "accept" fails a test. The same scenes run as planned must be accepted, so a
 critic that rejects everything fails too.
+
+The rollouts are read from ``tests/critics/observations/`` (what the critic was shown, with the
+oracle's values beside it): ``recipes.py`` says how each was made and makes it again, and
+``tests/regenerate/`` checks that they still come out so under the locked versions. A new release
+of the simulator moves chaotic rollouts; it cannot move these tests.
 """
 
 from __future__ import annotations
@@ -13,20 +18,10 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from critics.faulted import Run, run, vanilla
-from vcage.assets.catalog import CATALOG
-from vcage.critics.base import Verdict, View
-from vcage.critics.image import ROBOT, ImageCritic, _peak, _relief
+from critics.recipes import FAILURES, SCENARIOS, faulted, observed, planned, vanilla
+from vcage.critics.base import Verdict
+from vcage.critics.image import ROBOT, ImageCritic, _peak
 from vcage.critics.masks import touch
-from vcage.planning.goals import close_drawer, hang, open_drawer, press, put_in, put_on, turn_to_face
-from vcage.planning.schema import Predicate, Subtask
-from vcage.scene.compose import compose
-from vcage.scene.spec import ObjectSpec as O
-from vcage.scene.spec import SceneSpec
-from vcage.sim.render import Renderer
-from vcage.sim.world import World
-from vcage.subtasks.judge import render_views
-from vcage.tasks import predicates as P
 
 CRITIC = ImageCritic()
 
@@ -34,106 +29,24 @@ CRITIC = ImageCritic()
 def _judged_vanilla(goal: str, episode: int, index: int, oracle: dict[str, bool]) -> Verdict:
     """The critic's verdict on subtask ``index`` of Vanilla's episode ``episode`` of ``goal``, once the
     oracle's values there are checked to be ``oracle`` (the state the test describes)."""
-    obs, outcome = vanilla(goal, episode)[index]
-    assert outcome.oracle == oracle
-    return CRITIC.judge(obs)
+    case = observed(vanilla(goal, episode, index))
+    assert case.oracle == oracle
+    return CRITIC.judge(case.obs)
 
 
-def _sub(skill: str, args: dict[str, object], *preds: tuple[str, tuple[str, ...]]) -> Subtask:
-    return Subtask(skill=skill, args=args, description="a subtask under test",
-                   predicates=tuple(Predicate(name=n, args=a) for n, a in preds))
-
-
-BLOCK_PAD = (O("block", "block", (0.5, -0.12)), O("pad", "mouse_pad", (0.58, 0.1)))
-BREAD_BASKET = (O("bread", "bread", (0.5, -0.12)), O("basket", "basket", (0.58, 0.12)))
-BELL = (O("bell", "bell", (0.55, 0.05)),)
-CLOCK = (O("clock", "alarm_clock", (0.55, 0.05)),)
-STAPLER = (O("stapler", "stapler", (0.55, -0.05), yaw=1.0),)
-MOUSE_PAD = (O("mouse", "mouse", (0.5, -0.12)), O("pad", "mouse_pad", (0.55, 0.12)))
-TWO_BLOCKS = (O("a", "block", (0.5, -0.15)), O("b", "block", (0.55, 0.1)))
-STACK = (O("a", "block", (0.5, -0.12)), O("b", "block", (0.55, 0.1)))
-ROW_LEFT = (O("a", "block", (0.5, -0.1)), O("b", "block", (0.55, 0.05)))
-ROW_RIGHT = (O("a", "block", (0.5, 0.1)), O("b", "block", (0.55, -0.05)))
-CABINET = (O("cab", "cabinet", (0.68, 0.05), yaw=-0.2),)
-BOARD_AWAY = (O("board", "qr_board", (0.55, 0.1)),)  # its code faces +x, away from the robot
-MUG_RACK = (O("mug", "mug", (0.45, -0.12)), O("rack", "mug_rack", (0.63, 0.08)))
-BOARD_SIDEWAYS = (O("board", "qr_board", (0.55, 0.0), yaw=np.pi / 2),)  # its code faces the robot's left
-
-SCENARIOS: dict[str, tuple[tuple[O, ...], Subtask]] = {
-    "on": (BLOCK_PAD, put_on("block", "pad", "the block is on the pad")),
-    # the pad under the hand's home: a mouse never let go is carried back over it
-    "on_home": ((O("mouse", "mouse", (0.55, -0.12)), O("pad", "mouse_pad", (0.45, 0.0))),
-                put_on("mouse", "pad", "the mouse is on the pad")),
-    "inside": (BREAD_BASKET, put_in("bread", "basket", "the bread is in the basket")),
-    "pressed": (BELL, press("bell", "the bell is rung")),
-    "upright": (CLOCK, press("clock", "the clock's button is pressed")),
-    "pressed_lever": (STAPLER, press("stapler", "the stapler is pressed")),
-    "on_table": (MOUSE_PAD, _sub("pick_and_place", {"obj": "mouse", "xy": [0.55, 0.02]},
-                                 ("on_table", ("mouse",)), ("released", ("mouse",)))),
-    "near": (TWO_BLOCKS, _sub("pick_and_place", {"obj": "a", "xy": [0.55, 0.04]},
-                              ("near", ("a", "b")), ("released", ("a",)))),
-    "lifted": ((O("block", "block", (0.55, 0.0)),), _sub("grasp", {"obj": "block"}, ("lifted", ("block",)))),
-    "stacked": (STACK, _sub("pick_and_place", {"obj": "a", "target": "b"},
-                            ("stacked", ("b", "a")), ("released", ("a",)))),
-    "left_of": (ROW_LEFT, _sub("pick_and_place", {"obj": "a", "xy": [0.5, 0.18]},
-                               ("left_of", ("a", "b")), ("released", ("a",)))),
-    "right_of": (ROW_RIGHT, _sub("pick_and_place", {"obj": "a", "xy": [0.5, -0.18]},
-                                 ("right_of", ("a", "b")), ("released", ("a",)))),
-    "opened": (CABINET, open_drawer("cab", "the drawer is open")),
-    "closed": (CABINET, close_drawer("cab", "the drawer is shut")),  # after opening it (BEFORE)
-    "inside_drawer": ((*CABINET, O("soap", "soap", (0.5, -0.15))),
-                      put_in("soap", "cab", "the soap is in the open drawer")),  # after opening it
-    "facing": (BOARD_SIDEWAYS, turn_to_face("board", "the board faces the robot")),
-    "hanging": (MUG_RACK, hang("mug", "rack", "the mug hangs on the rack")),
-}
-BEFORE = {"closed": (open_drawer("cab", "the drawer is open"),),
-          "inside_drawer": (open_drawer("cab", "the drawer is open"),)}
-
-# (scenario, fault, seed, the predicate that must fail in the oracle and in the critic's checks)
-FAILURES = [
-    ("on", "off_target", 1, "on(block, pad)"),
-    ("on", "release_late", 2, "on(block, pad)"),
-    ("inside", "off_target", 1, "inside(bread, basket)"),
-    ("inside", "on_edge", 0, "inside(bread, basket)"),
-    ("on", "no_release", 0, "released(block)"),
-    ("on_home", "no_release", 0, "on(mouse, pad)"),  # held over the pad, higher than resting on it allows
-    ("inside", "no_release", 0, "released(bread)"),  # the bread in the hand shows from the top
-    ("pressed", "press_hover", 0, "pressed(bell)"),
-    ("pressed", "press_miss", 0, "pressed(bell)"),
-    ("upright", "press_miss", 2, "pressed(clock)"),  # touched and deep enough, but beside the button
-    ("pressed", "press_light", 0, "pressed(bell)"),
-    ("pressed", "press_light", 3, "pressed(bell)"),
-    ("upright", "press_light", 1, "pressed(clock)"),
-    ("pressed_lever", "press_light", 3, "pressed(stapler)"),
-    ("upright", "knock_over", 1, "upright(clock)"),
-    ("on_table", "off_target", 2, "on_table(mouse)"),
-    ("near", "off_target", 0, "near(a, b)"),
-    ("near", "release_early", 0, "near(a, b)"),
-    ("lifted", "grasp_miss", 0, "lifted(block)"),
-    ("stacked", "off_target", 0, "stacked(b, a)"),
-    ("left_of", "wrong_object", 0, "left_of(a, b)"),
-    ("right_of", "wrong_object", 0, "right_of(a, b)"),
-    ("opened", "pull_short", 1, "opened(cab)"),
-    ("closed", "pull_short", 2, "closed(cab)"),
-    # over the cabinet's hull, as resting in it would be, but mostly on its body beside the drawer
-    ("inside_drawer", "release_late", 1, "inside(soap, cab)"),
-    # turned 30-60% of the quarter turn it needed: its plain back shows obliquely to the front camera,
-    # as it does when the board faces the robot; only its axis from the top tells
-    ("facing", "turn_short", 0, "facing(board)"),
-    ("hanging", "hang_short", 0, "hanging(mug, rack)"),  # let go beside the peg's end: it falls on the base
-]
-
-
-def _run(scenario: str, fault: str | None = None, seed: int = 0) -> Run:
-    objects, subtask = SCENARIOS[scenario]
-    return run(objects, subtask, fault, seed, BEFORE.get(scenario, ()))
+def _placed(name: str) -> tuple[bool, Verdict]:
+    """The oracle's and the critic's verdicts on a subtask done as planned whose views after (and some
+    before) were replaced by the scene with the placed object dropped in a given pose and settled
+    (``recipes._set_down``): whether the oracle counts its placing predicates true, and the verdict."""
+    case = observed(name)
+    return case.success, CRITIC.judge(case.obs)
 
 
 @pytest.mark.parametrize("scenario", sorted(SCENARIOS))
 def test_the_scene_done_as_planned_is_accepted(scenario: str) -> None:
-    result = _run(scenario)
-    verdict = CRITIC.judge(result.obs)
-    assert result.success, result.outcome.oracle
+    case = observed(planned(scenario))
+    verdict = CRITIC.judge(case.obs)
+    assert case.success, case.oracle
     assert verdict.accept, verdict.reason
 
 
@@ -141,10 +54,10 @@ def test_the_scene_done_as_planned_is_accepted(scenario: str) -> None:
                          ids=[f"{f}-{p}" for _, f, _, p in FAILURES])
 def test_an_injected_silent_failure_is_rejected_by_its_check(scenario: str, fault: str, seed: int,
                                                              predicate: str) -> None:
-    result = _run(scenario, fault, seed)
-    assert result.applied and result.outcome.skill_error is None
-    assert result.outcome.oracle[predicate] is False, result.outcome.oracle  # a real failure
-    verdict = CRITIC.judge(result.obs)
+    case = observed(faulted(scenario, fault, seed))
+    assert case.extra["applied"]
+    assert case.oracle[predicate] is False, case.oracle  # a real failure
+    verdict = CRITIC.judge(case.obs)
     assert not verdict.accept
     assert verdict.details["checks"][predicate] is False, verdict.reason
     assert predicate in verdict.reason
@@ -154,62 +67,18 @@ def test_an_object_put_down_on_clutter_that_lies_on_its_target_is_not_on_it() ->
     """A block lies on the pad; the mouse put on the pad comes to rest on the block. From the top the
     mouse lies over the pad as it would on it; what the top view showed before (the block, 4.5 cm
     high, where the mouse is now) says it cannot be down on the pad."""
-    objects = (*MOUSE_PAD, O("block", "block", (0.55, 0.12), z=0.8))
-    result = run(objects, put_on("mouse", "pad", "the mouse is on the pad"))
-    assert result.outcome.oracle == {"on(mouse, pad)": False, "released(mouse)": True}
-    verdict = CRITIC.judge(result.obs)
+    case = observed("mouse-onto-a-block-on-the-pad")
+    assert case.oracle == {"on(mouse, pad)": False, "released(mouse)": True}
+    verdict = CRITIC.judge(case.obs)
     assert not verdict.accept
     assert "mouse lies over block" in verdict.reason
-
-
-def _set_down(scene: tuple[O, ...], subtask: Subtask, placed: O, quat: tuple[float, float, float, float],
-              extra: tuple[O, ...] = (), moved: tuple[O, ...] = (),
-              lay_before: tuple[O, tuple[float, float, float, float]] | None = None) -> tuple[bool, Verdict]:
-    """The oracle's and the critic's verdicts on ``subtask`` done as planned in ``scene``, with the
-    "after" views replaced by the same scene (and the objects ``extra``, unlabelled; ``moved`` in
-    place of the scene's objects of the same names) with ``placed`` dropped from its ``z`` in
-    orientation ``quat`` and settled (no injected fault leaves an object in such a pose reliably).
-    ``lay_before``: the "before" views replaced likewise, with ``placed`` there as given."""
-    done = run(scene, subtask)
-    assert done.success and CRITIC.judge(done.obs).accept
-    instead = {o.name: o for o in moved}
-    others = tuple(instead.get(o.name, o) for o in scene if o.name != placed.name)
-    assert scene[0].name == placed.name  # the segmentation labels keep their order
-    world, after = _settled((placed, *others, *extra), quat)
-    placing = [p for p in subtask.predicates if p.name != "released"]
-    oracle = all(P.ORACLE_CHECKS.get(p.name)(world, *p.args) for p in placing)
-    obs = replace(done.obs, after=after)
-    if lay_before is not None:
-        obs = replace(obs, before=_settled((lay_before[0], *scene[1:]), lay_before[1])[1])
-    return oracle, CRITIC.judge(obs)
-
-
-def _settled(objects: tuple[O, ...], quat: tuple[float, float, float, float]
-             ) -> tuple[World, dict[str, View]]:
-    """The scene of ``objects`` with the first dropped from its ``z`` in orientation ``quat``, settled,
-    and its views (the segmentation labels follow the objects' order)."""
-    world = compose(SceneSpec(objects=objects)).make_world()
-    adr = world.model.jnt_qposadr[world.model.body_jntadr[world.object(objects[0].name).body_id]]
-    world.data.qpos[adr + 3:adr + 7] = quat
-    world.forward()
-    world.settle(1.0)
-    with Renderer(world, 320, 240) as renderer:
-        return world, render_views(renderer)
-
-
-def _mouse_set_on_the_pad(quat: tuple[float, float, float, float], z: float) -> Verdict:
-    """A mouse put on the pad, replaced by one settled in orientation ``quat``; the oracle must say
-    it is not on the pad."""
-    oracle, verdict = _set_down(MOUSE_PAD, put_on("mouse", "pad", "the mouse is on the pad"),
-                                O("mouse", "mouse", (0.55, 0.12), z=z), quat)
-    assert not oracle
-    return verdict
 
 
 def test_a_mouse_on_its_back_on_the_pad_is_not_on_it() -> None:
     """Vanilla rollouts left mice on their backs on the pad (the oracle: not on it; its outline from
     the top is the same). The mouse's domed top was far from a plane; its flat underside is not."""
-    verdict = _mouse_set_on_the_pad((0.0, 1.0, 0.0, 0.0), 0.9)  # half a turn about x
+    oracle, verdict = _placed("mouse-on-its-back-on-the-pad")  # half a turn about x
+    assert not oracle
     assert not verdict.accept and "turned over" in verdict.reason, verdict.reason
 
 
@@ -217,28 +86,9 @@ def test_a_mouse_that_lay_on_its_back_before_and_lies_so_on_the_pad_is_not_on_it
     """Vanilla left mice on their backs before their subtask too, and carried them so onto the pad:
     compared with itself before, the top kept its (flat) shape. The mouse's type declares its dome,
     and the flat underside lies far closer to a plane than the dome does."""
-    oracle, verdict = _set_down(MOUSE_PAD, put_on("mouse", "pad", "the mouse is on the pad"),
-                                O("mouse", "mouse", (0.55, 0.12), z=0.9), (0.0, 1.0, 0.0, 0.0),
-                                lay_before=(O("mouse", "mouse", (0.5, -0.12), z=0.9), (0.0, 1.0, 0.0, 0.0)))
+    oracle, verdict = _placed("mouse-on-its-back-before-and-on-the-pad")
     assert not oracle
     assert not verdict.accept and "top is flat" in verdict.reason, verdict.reason
-
-
-@pytest.mark.parametrize("name", CATALOG.names_where(lambda t: t.top_relief > 0))
-def test_a_declared_top_relief_is_what_the_top_view_shows_of_the_type_standing(name: str) -> None:
-    """``ObjectType.top_relief`` is held to the model: rendered standing alone at scale 1 at four
-    headings, its top lies at least that far from a plane, and not much further on average."""
-    reliefs = []
-    for x, y, yaw in ((0.5, 0.0, 0.0), (0.55, 0.15, 1.0), (0.6, -0.15, 2.2), (0.45, 0.1, 2.9)):
-        world = compose(SceneSpec(objects=(O("x", name, (x, y), yaw=yaw),))).make_world()
-        world.settle(0.3)
-        with Renderer(world, 320, 240) as renderer:
-            top = render_views(renderer)["top"]
-        relief = _relief(top, top.segmentation == 0)
-        assert relief is not None
-        reliefs.append(relief)
-    declared = CATALOG.get(name).top_relief
-    assert declared <= min(reliefs) and declared >= 0.85 * float(np.mean(reliefs)), reliefs
 
 
 def test_a_mouse_tipped_over_at_a_slant_on_the_pad_is_not_on_it() -> None:
@@ -246,8 +96,7 @@ def test_a_mouse_tipped_over_at_a_slant_on_the_pad_is_not_on_it() -> None:
     underside up, part of its dome showing, so its top lies far enough from a plane (0.46 of its
     relief before) to pass the comparison with itself before; but under half as far as the dome its
     type declares (2.6 mm, where a mouse standing shows 5.4 mm at its smallest scale)."""
-    oracle, verdict = _set_down(MOUSE_PAD, put_on("mouse", "pad", "the mouse is on the pad"),
-                                O("mouse", "mouse", (0.583, 0.107), z=0.8), (0.207, -0.625, 0.714, -0.238))
+    oracle, verdict = _placed("mouse-tipped-at-a-slant-on-the-pad")
     assert not oracle
     assert not verdict.accept and "top is flat (2.6 mm from a plane" in verdict.reason, verdict.reason
 
@@ -285,12 +134,10 @@ def test_a_mouse_standing_on_its_end_on_the_pad_is_not_on_it() -> None:
     """Vanilla rollouts left mice standing on an end or propped on clutter on the pad: from the top
     they lie over it, their lowest point is down on it and their top is no flatter than before. Stood
     on its end, its top stands 5 cm higher than a mouse put down on the pad reaches."""
-    verdict = _mouse_set_on_the_pad((np.cos(np.pi / 4), 0.0, np.sin(np.pi / 4), 0.0), 0.85)  # about y
+    oracle, verdict = _placed("mouse-on-its-end-on-the-pad")  # a quarter turn about y
+    assert not oracle
     assert not verdict.accept and "higher than mouse standing on pad's surface reaches" in verdict.reason, \
         verdict.reason
-
-
-CUP_COASTER = (O("cup", "cup", (0.5, -0.12)), O("coaster", "coaster", (0.58, 0.1)))
 
 
 def test_a_cup_lying_on_its_side_across_the_coaster_is_not_on_it() -> None:
@@ -298,9 +145,7 @@ def test_a_cup_lying_on_its_side_across_the_coaster_is_not_on_it() -> None:
     base's centre 4 cm up): from the top most of the cup lies over the coaster, its lowest point is
     down on it, and it is round either way up. Its top, 7 cm above the coaster where it stood 9 cm
     tall, is nearer lying than standing."""
-    oracle, verdict = _set_down(CUP_COASTER, put_on("cup", "coaster", "the cup is on the coaster"),
-                                O("cup", "cup", (0.58, 0.145), z=0.85),
-                                (np.cos(np.pi / 4), np.sin(np.pi / 4), 0.0, 0.0))  # a quarter turn about x
+    oracle, verdict = _placed("cup-on-its-side-across-the-coaster")  # a quarter turn about x
     assert not oracle
     assert not verdict.accept and "lies on its side" in verdict.reason, verdict.reason
 
@@ -309,10 +154,7 @@ def test_a_cup_lying_on_its_side_over_a_coaster_it_hides_is_not_on_it() -> None:
     """Where the cup hides most of a coaster that moved (knocked as the cup fell), the top view cannot
     say where the coaster is, and the front view decides whether the cup rests on it; lying on its
     side, it is not on it all the same."""
-    oracle, verdict = _set_down(CUP_COASTER, put_on("cup", "coaster", "the cup is on the coaster"),
-                                O("cup", "cup", (0.58, 0.145), z=0.85),
-                                (np.cos(np.pi / 4), np.sin(np.pi / 4), 0.0, 0.0),
-                                moved=(O("coaster", "coaster", (0.585, 0.11)),))
+    oracle, verdict = _placed("cup-on-its-side-over-a-coaster-it-hides")
     assert not oracle
     assert not verdict.accept and "lies on its side" in verdict.reason, verdict.reason
 
@@ -348,9 +190,7 @@ def test_a_cup_whose_height_reads_lying_but_that_shows_its_inside_is_on_the_coas
 def test_a_cup_standing_on_the_coaster_is_on_it_whatever_its_scale() -> None:
     """The side check reads the cup's scale from its height before: a small cup standing on the
     coaster is not taken for a large one lying down."""
-    small = (O("cup", "cup", (0.5, -0.12), scale=0.9), O("coaster", "coaster", (0.58, 0.1)))
-    oracle, verdict = _set_down(small, put_on("cup", "coaster", "the cup is on the coaster"),
-                                O("cup", "cup", (0.58, 0.1), z=0.8, scale=0.9), (1.0, 0.0, 0.0, 0.0))
+    oracle, verdict = _placed("small-cup-standing-on-the-coaster")
     assert oracle
     assert verdict.accept, verdict.reason
 
@@ -359,8 +199,7 @@ def test_a_cup_moved_onto_the_middle_of_a_coaster_it_half_hid_is_on_it() -> None
     """A Vanilla rollout began with the cup standing off-centre on the coaster and ended with it in
     the middle: the coaster's middle was hidden before and after, so its outline is a ring with
     fewer pixels than the cup. The overlap is asked of the region smaller by its hull (the cup)."""
-    scene = (O("cup", "cup", (0.58, 0.08), z=0.755, scale=1.2), O("coaster", "coaster", (0.58, 0.1)))
-    done = run(scene, put_on("cup", "coaster", "the cup is on the coaster"))
+    done = observed("cup-moved-to-the-middle-of-a-coaster-it-half-hid")
     assert done.success
     verdict = CRITIC.judge(done.obs)
     assert verdict.accept, verdict.reason
@@ -371,15 +210,9 @@ def test_a_cup_put_on_the_coaster_beside_a_basket_pushed_and_turned_is_on_it() -
     translation only, the basket's outline before overhangs it at two corners, one of them under the
     cup standing on the coaster beside it, which then seemed to lie over the basket's wall (6 cm
     high). Followed turned as well, the basket lies beside the cup."""
-    scene = (*CUP_COASTER, O("basket", "basket", (0.4, 0.15)))
-    oracle, verdict = _set_down(scene, put_on("cup", "coaster", "the cup is on the coaster"),
-                                O("cup", "cup", (0.58, 0.1), z=0.8), (1.0, 0.0, 0.0, 0.0),
-                                moved=(O("basket", "basket", (0.71, 0.142), yaw=0.5),))
+    oracle, verdict = _placed("cup-on-the-coaster-beside-a-turned-basket")
     assert oracle
     assert verdict.accept, verdict.reason
-
-
-SEAL_MAT = (O("seal", "seal", (0.5, -0.12)), O("mat", "stamp_mat", (0.58, 0.1)))
 
 
 def test_a_seal_that_lay_on_its_side_before_and_lies_so_on_the_mat_is_not_on_it() -> None:
@@ -388,10 +221,7 @@ def test_a_seal_that_lay_on_its_side_before_and_lies_so_on_the_mat_is_not_on_it(
     height before gives no scale, and their top shows no flat face it did not show before. A seal's
     top, 4.8 cm above the mat there, is nearer its longest side across at any scale (5.5 cm) than the
     least it stands on its base (9.6 cm)."""
-    lying = (float(np.cos(0.89)), float(np.sin(0.89)), 0.0, 0.0)  # 1.78 rad about x, as they lay
-    oracle, verdict = _set_down(SEAL_MAT, put_on("seal", "mat", "the seal is on the mat"),
-                                O("seal", "seal", (0.58, 0.13), z=0.8), lying,
-                                lay_before=(O("seal", "seal", (0.5, -0.12), z=0.8), lying))
+    oracle, verdict = _placed("seal-on-its-side-before-and-on-the-mat")  # 1.78 rad about x, as they lay
     assert not oracle
     assert not verdict.accept and "lies on its side" in verdict.reason, verdict.reason
 
@@ -401,8 +231,7 @@ def test_a_loaf_upside_down_in_the_basket_is_inside_it() -> None:
     its top, a flat end where the crust had been curved, was read as turned over. On a surface that
     means it does not rest on its base; in a container an object may lie any way up. Upside down,
     its flat underside shows from the top."""
-    oracle, verdict = _set_down(BREAD_BASKET, put_in("bread", "basket", "the bread is in the basket"),
-                                O("bread", "bread", (0.58, 0.12), z=0.8), (0.0, 1.0, 0.0, 0.0))
+    oracle, verdict = _placed("loaf-upside-down-in-the-basket")
     assert oracle
     assert verdict.accept, verdict.reason
 
@@ -411,29 +240,20 @@ def test_a_loaf_standing_on_end_in_the_basket_is_inside_it() -> None:
     """A Vanilla rollout left a loaf (at a large scale, in a small basket) standing on its end in the
     basket. Its top stood higher above the rim than the loaf lying down is tall; in a container its
     longest side bounds that, once its top view shows it turned."""
-    loaf = O("bread", "bread", (0.5, -0.12), scale=1.1)
-    basket = O("basket", "basket", (0.58, 0.12), scale=0.9)
-    oracle, verdict = _set_down((loaf, basket), put_in("bread", "basket", "the bread is in the basket"),
-                                replace(loaf, xy=(0.58 - 0.034, 0.12), z=0.83),
-                                (np.cos(np.pi / 4), 0.0, np.sin(np.pi / 4), 0.0))  # long axis up
+    oracle, verdict = _placed("loaf-on-its-end-in-the-basket")  # long axis up
     assert oracle
     assert verdict.accept, verdict.reason
 
 
-@pytest.mark.parametrize(("loaf_scale", "tilt"), [(1.1, 0.8), (0.9, 0.6)], ids=["underside", "top"])
-def test_a_loaf_leaning_from_the_floor_against_the_rim_is_inside_the_basket(loaf_scale: float,
-                                                                           tilt: float) -> None:
+@pytest.mark.parametrize("which", ["underside", "top"])  # scale 1.1 tilted 0.8 rad; 0.9 tilted 0.6
+def test_a_loaf_leaning_from_the_floor_against_the_rim_is_inside_the_basket(which: str) -> None:
     """Vanilla rollouts left loaves leaning in the basket, one end on the floor and the other against
     the rim (inside for the oracle: the lowest point on the floor, the centre within the walls). The
     critic read such a loaf as lying level: its underside its own height under its highest point, at
     the rim (the large loaf), or its top no higher than its height above the rim (the small one). Its
     sloping top says it leans: its underside is judged under the top's lower end, and its longest
     side bounds its top."""
-    loaf = O("bread", "bread", (0.5, -0.12), scale=loaf_scale)
-    basket = O("basket", "basket", (0.58, 0.12), scale=0.9)
-    oracle, verdict = _set_down((loaf, basket), put_in("bread", "basket", "the bread is in the basket"),
-                                replace(loaf, xy=(0.62, 0.12), z=0.83),
-                                (np.cos(tilt / 2), 0.0, np.sin(tilt / 2), 0.0))  # about y, its low end away
+    oracle, verdict = _placed(f"loaf-leaning-against-the-rim-{which}")  # about y, its low end away
     assert oracle
     assert verdict.accept, verdict.reason
 
@@ -443,12 +263,7 @@ def test_a_loaf_leaning_on_a_cup_that_stands_in_the_basket_is_inside_it() -> Non
     came to rest leaning on the cup, their lower end on the floor (inside for the oracle). From the
     top a loaf lies over the cup, whose top stood above the rim, which says that a loaf lying level
     rests on it; a leaning one may rest against it, and its lower end decides."""
-    scene = (O("bread", "bread", (0.5, -0.12)), O("basket", "basket", (0.58, 0.12)),
-             O("cup", "cup", (0.625, 0.12), z=0.735))  # on the basket's floor
-    tilt = 0.6  # about y, its raised end towards the cup
-    oracle, verdict = _set_down(scene, put_in("bread", "basket", "the bread is in the basket"),
-                                O("bread", "bread", (0.57, 0.12), z=0.83),
-                                (np.cos(tilt / 2), 0.0, -np.sin(tilt / 2), 0.0))
+    oracle, verdict = _placed("loaf-leaning-on-a-cup-in-the-basket")  # its raised end towards the cup
     assert oracle
     assert verdict.accept, verdict.reason
 
@@ -457,9 +272,7 @@ def test_a_loaf_lying_on_a_cup_above_the_rim_is_not_inside_the_basket() -> None:
     """A Vanilla rollout left a loaf lying flat on a cup that stood in the basket, all of it above the
     rim. It lies as it did on the table, so its underside is its own height under its top: above
     the rim (and its height, not its longest side, bounds its top)."""
-    cup = O("cup", "cup", (0.58, 0.12), z=0.735)  # on the basket's floor
-    oracle, verdict = _set_down(BREAD_BASKET, put_in("bread", "basket", "the bread is in the basket"),
-                                O("bread", "bread", (0.58, 0.12), z=0.9), (1.0, 0.0, 0.0, 0.0), extra=(cup,))
+    oracle, verdict = _placed("loaf-lying-on-a-cup-above-the-rim")  # the cup on the basket's floor
     assert not oracle
     assert not verdict.accept and "above basket's rim" in verdict.reason, verdict.reason
 
@@ -468,11 +281,7 @@ def test_a_loaf_bridging_the_baskets_rims_is_not_inside_it() -> None:
     """A large loaf put across a small basket can come to rest on both long rims: from the top it lies
     over the basket, no higher than a loaf in a basket may reach, but its underside is at the rim's
     height (the oracle: not inside). Injected faults left five such loaves in the balanced set."""
-    loaf = O("bread", "bread", (0.5, -0.12), scale=1.1)
-    basket = O("basket", "basket", (0.58, 0.12), scale=0.9)
-    across = (np.cos(np.pi / 4), 0.0, 0.0, np.sin(np.pi / 4))  # its long side along the basket's short one
-    oracle, verdict = _set_down((loaf, basket), put_in("bread", "basket", "the bread is in the basket"),
-                                replace(loaf, xy=(0.58, 0.12), z=0.83), across)
+    oracle, verdict = _placed("loaf-bridging-the-rims")  # its long side along the basket's short one
     assert not oracle
     assert not verdict.accept, "a loaf on the rims was accepted"
     assert "cm under basket's rim: it rests on the rim" in verdict.reason, verdict.reason
@@ -519,8 +328,7 @@ def test_a_bell_leaning_less_than_the_oracles_bound_is_upright() -> None:
 def test_a_loaf_lying_level_against_the_baskets_wall_is_inside_it() -> None:
     """Dropped over the wall, a loaf comes to rest on the floor against its inside: its centre lies
     as near the basket's outline as a loaf in the basket can (4.1 cm in), and it is inside."""
-    oracle, verdict = _set_down(BREAD_BASKET, put_in("bread", "basket", "the bread is in the basket"),
-                                O("bread", "bread", (0.58, 0.185), z=0.76), (1.0, 0.0, 0.0, 0.0))
+    oracle, verdict = _placed("loaf-level-against-the-wall-inside")
     assert oracle
     assert verdict.accept, verdict.reason
 
@@ -529,9 +337,7 @@ def test_a_block_set_diagonally_off_centre_on_a_block_is_on_it() -> None:
     """A block resting on another with its centre over the face but off it along both axes covers
     under half of it from the top (Vanilla towers the oracle counts stacked showed 41-57%). A cube's
     surface is its whole face, as large as the block on it, so the centre decides, not the overlap."""
-    oracle, verdict = _set_down(STACK, _sub("pick_and_place", {"obj": "a", "target": "b"},
-                                            ("on", ("a", "b")), ("released", ("a",))),
-                                O("a", "block", (0.55 + 0.016, 0.1 + 0.015), z=0.79), (1.0, 0.0, 0.0, 0.0))
+    oracle, verdict = _placed("block-diagonally-off-centre-on-a-block")
     assert oracle
     assert verdict.accept, verdict.reason
 
@@ -540,10 +346,8 @@ def test_a_block_put_down_where_another_stands_is_not_on_the_table() -> None:
     """Put down at a spot another block of its size occupies, the block comes to rest on it: from the
     top it shows where it should, and its neighbour, no larger, mostly hides under it. The heights of
     the top view say it stands a block higher than the table allows."""
-    objects = (O("a", "block", (0.5, -0.12)), O("b", "block", (0.55, 0.05)))
-    result = run(objects, _sub("pick_and_place", {"obj": "a", "xy": [0.55, 0.05]},
-                               ("on_table", ("a",)), ("released", ("a",))))
-    assert result.outcome.oracle == {"on_table(a)": False, "released(a)": True}
+    result = observed("block-put-down-where-another-stands")
+    assert result.oracle == {"on_table(a)": False, "released(a)": True}
     verdict = CRITIC.judge(result.obs)
     assert not verdict.accept and "higher than resting on the table allows" in verdict.reason, verdict.reason
 
@@ -552,8 +356,7 @@ def test_a_press_hidden_from_the_front_by_a_cup_is_judged_from_the_top() -> None
     """A cup stands between the bell and the front camera: the fingers go down behind it, so the
     front view shows no contact. The top view's cover and depth say the press was full; a press
     beside the button, equally hidden, still fails the cover."""
-    objects = (*BELL, O("cup", "cup", (0.62, 0.05)))
-    done = run(objects, press("bell", "the bell is rung"))
+    done = observed("bell-behind-a-cup")
     front = done.obs.during["front"]
     bell = front.segmentation == done.obs.labels.index("bell")
     assert done.success and not touch(front.segmentation == ROBOT, bell, front.depth)
@@ -563,8 +366,8 @@ def test_a_press_hidden_from_the_front_by_a_cup_is_judged_from_the_top() -> None
              for m in ("before", "during", "after")}
     verdict = CRITIC.judge(replace(done.obs, **blind))  # without the top view's depth: no evidence left
     assert not verdict.accept and "hides where the hand met bell" in verdict.reason, verdict.reason
-    missed = run(objects, press("bell", "the bell is rung"), "press_miss", 0)
-    assert missed.outcome.oracle["pressed(bell)"] is False
+    missed = observed("bell-behind-a-cup-press_miss-0")
+    assert missed.oracle["pressed(bell)"] is False
     verdict = CRITIC.judge(missed.obs)
     assert not verdict.accept and "covered" in verdict.reason, verdict.reason
 
@@ -573,16 +376,15 @@ def test_a_press_on_a_bell_the_front_view_never_shows_is_judged_from_the_top() -
     """A cereal box stands between the bell and the front camera and hides all of it, before and
     during the press (a Vanilla rollout hid a bell behind a basket so): the front view can tell
     nothing, the top view's cover and depth decide, and a hovering hand still fails them."""
-    objects = (*BELL, O("box", "cereal_box", (0.64, 0.05)))
-    done = run(objects, press("bell", "the bell is rung"))
+    done = observed("bell-behind-a-box")
     bell = done.obs.labels.index("bell")
     fronts = (done.obs.before["front"], done.obs.during["front"])
     assert not any((v.segmentation == bell).any() for v in fronts)
     assert done.success
     verdict = CRITIC.judge(done.obs)
     assert verdict.accept, verdict.reason
-    hover = run(objects, press("bell", "the bell is rung"), "press_hover", 0)
-    assert hover.outcome.oracle["pressed(bell)"] is False
+    hover = observed("bell-behind-a-box-press_hover-0")
+    assert hover.oracle["pressed(bell)"] is False
     verdict = CRITIC.judge(hover.obs)
     assert not verdict.accept and "short of pressing" in verdict.reason, verdict.reason
 
@@ -592,16 +394,15 @@ def test_a_press_on_a_bell_showing_a_sliver_beside_what_hides_it_is_judged_from_
     Vanilla rollout): the hand goes down behind the holder, beside the sliver's columns. The bell
     reaches on behind the holder, so where the hand met it cannot be seen, and the top view judges:
     a full press passes, one beside the button or short of it does not."""
-    objects = (*BELL, O("holder", "pen_holder", (0.63, 0.05)))
-    done = run(objects, press("bell", "the bell is rung"))
+    done = observed("bell-behind-a-holder")
     front = done.obs.during["front"]
     assert 0 < (front.segmentation == done.obs.labels.index("bell")).sum() < 10  # a sliver shows
     assert done.success
     verdict = CRITIC.judge(done.obs)
     assert verdict.accept, verdict.reason
     for fault, why in (("press_miss", "covered"), ("press_light", "short of pressing")):
-        failed = run(objects, press("bell", "the bell is rung"), fault, 0)
-        assert failed.outcome.oracle["pressed(bell)"] is False
+        failed = observed(f"bell-behind-a-holder-{fault}-0")
+        assert failed.oracle["pressed(bell)"] is False
         verdict = CRITIC.judge(failed.obs)
         assert not verdict.accept and why in verdict.reason, verdict.reason
 
@@ -610,8 +411,8 @@ def test_a_lone_stray_depth_pixel_inside_the_bell_is_not_its_top() -> None:
     """One pixel inside a bell's outline in the top view read 59 cm above the table (a Vanilla rollout):
     taken as the bell's top, the press read half a metre past a full one, "the bell gave way". The
     top is the highest pixel that a neighbour inside comes near; a light press stays short."""
-    done = run(BELL, press("bell", "the bell is rung"))
-    light = run(BELL, press("bell", "the bell is rung"), "press_light", 0)
+    done = observed(planned("pressed"))
+    light = observed(faulted("pressed", "press_light", 0))
     assert done.success and not light.success
     for result, accept in ((done, True), (light, False)):
         top = result.obs.before["top"]
@@ -640,9 +441,8 @@ def test_a_press_that_rocks_the_clock_is_refused() -> None:
     """A clock standing with one side on a marker rocks down onto it under the hand (as clocks on
     clutter did on Vanilla rollouts): the hand reads deeper than the button goes, though its cover
     and depth pass and the clock shows as before from the top. The oracle: not upright."""
-    scene = (O("clock", "alarm_clock", (0.55, 0.05), z=0.765), O("marker", "marker", (0.55, 0.075)))
-    result = run(scene, press("clock", "the clock's button is pressed"))
-    assert result.outcome.oracle == {"pressed(clock)": True, "upright(clock)": False}
+    result = observed("clock-rocking-onto-a-marker")
+    assert result.oracle == {"pressed(clock)": True, "upright(clock)": False}
     verdict = CRITIC.judge(result.obs)
     assert not verdict.accept and "gave way under it" in verdict.reason, verdict.reason
 
@@ -650,8 +450,8 @@ def test_a_press_that_rocks_the_clock_is_refused() -> None:
 def test_a_press_is_judged_at_its_own_lowest_moment() -> None:
     """A sweep after the press (knocking nothing over here) takes the hand lower than the press did;
     the views "during" the subtask are still those of the press, which the critic accepts."""
-    result = _run("pressed", "knock_over", 1)
-    assert result.applied and result.success, result.outcome.oracle
+    result = observed(faulted("pressed", "knock_over", 1))
+    assert result.extra["applied"] and result.success, result.oracle
     verdict = CRITIC.judge(result.obs)
     assert verdict.accept, verdict.reason
 
@@ -660,10 +460,8 @@ def test_a_board_put_back_with_its_code_away_from_the_robot_does_not_face_it() -
     """Picked up and put back unturned, the board's plate lies across the way to the robot, as when
     it faces it: only the front view (the code's contrast towards the front camera, opposite the
     robot) tells that it faces away."""
-    here = BOARD_AWAY[0].xy
-    result = run(BOARD_AWAY, _sub("pick_and_place", {"obj": "board", "xy": list(here)},
-                                  ("facing", ("board",)), ("released", ("board",))))
-    assert result.outcome.oracle["facing(board)"] is False and result.outcome.oracle["released(board)"]
+    result = observed("board-put-back-unturned")
+    assert result.oracle["facing(board)"] is False and result.oracle["released(board)"]
     verdict = CRITIC.judge(result.obs)
     assert verdict.details["checks"] == {"facing(board)": False, "released(board)": True}, verdict.reason
     assert "faces away from the robot" in verdict.reason
@@ -671,10 +469,8 @@ def test_a_board_put_back_with_its_code_away_from_the_robot_does_not_face_it() -
 
 def test_a_mug_hung_on_one_rack_does_not_hang_from_the_other() -> None:
     """High above the table, as hanging makes it, but on the wrong rack: it touches only that one."""
-    racks = (*MUG_RACK, O("other", "mug_rack", (0.45, 0.25)))
-    result = run(racks, _sub("hang", {"obj": "mug", "target": "rack"},
-                             ("hanging", ("mug", "other")), ("released", ("mug",))))
-    assert result.outcome.oracle == {"hanging(mug, other)": False, "released(mug)": True}
+    result = observed("mug-hung-on-the-other-rack")
+    assert result.oracle == {"hanging(mug, other)": False, "released(mug)": True}
     verdict = CRITIC.judge(result.obs)
     assert verdict.details["checks"]["hanging(mug, other)"] is False, verdict.reason
     assert "does not touch other" in verdict.reason
@@ -695,7 +491,7 @@ def test_a_lone_pixel_at_the_outline_does_not_set_how_high_the_button_is() -> No
 
     from vcage.critics.masks import dilate
 
-    result = _run("upright", "press_light", 1)
+    result = observed(faulted("upright", "press_light", 1))
     obs = result.obs
     view = obs.before["top"]
     clock = view.segmentation == obs.labels.index("clock")
@@ -712,7 +508,7 @@ def test_a_stray_pixel_inside_a_cabinet_does_not_shrink_how_far_its_drawer_is_ou
     """A drawer left half open, with one pixel inside the cabinet's outline reading 6 cm above its top
     (a stray depth, as seen on rollouts): the cabinet's scale comes from its type's range, so the
     drawer still measures as out, not as shut."""
-    result = _run("closed", "pull_short", 2)
+    result = observed(faulted("closed", "pull_short", 2))
     obs = result.obs
     view = obs.after["top"]
     cab = view.segmentation == obs.labels.index("cab")
