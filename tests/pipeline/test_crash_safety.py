@@ -24,6 +24,8 @@ from vcage.data.layout import ATTEMPTS_LOG
 from vcage.data.verify import verify
 from vcage.pipeline.attempt_log import read
 
+pytestmark = pytest.mark.slow  # SIGKILL trials of real generation runs
+
 EPISODES = 2
 TIMED_KILLS = 10  # at evenly spread moments of the run
 # in the write windows of both episodes: right after the n-th temporary file of the run appears, or

@@ -84,6 +84,7 @@ def test_same_seed_same_episode_and_replayable_states(tmp_path: Path) -> None:
         SceneSpec.from_dict({"objects": [{"name": "x"}]})
 
 
+@pytest.mark.slow
 def test_workers_make_the_same_dataset(tmp_path: Path) -> None:
     cfg = GenerateConfig(**SMALL)
     one = generate(SHORT, 2, tmp_path / "one", cfg)
@@ -111,6 +112,7 @@ def test_workers_make_the_same_dataset(tmp_path: Path) -> None:
     assert not (tmp_path / "bad" / "meta").exists()
 
 
+@pytest.mark.slow
 def test_ray_executor_makes_the_same_dataset(tmp_path: Path) -> None:
     ray = pytest.importorskip("ray")
     cfg = GenerateConfig(**SMALL)
@@ -165,6 +167,7 @@ def _vanilla_fused(tmp_path: Path, tries: int = 30) -> tuple[int, Path, dict]:
                          "fuses objects as often as it did (about one scene in three)")
 
 
+@pytest.mark.slow
 def test_a_vanilla_episode_that_starts_fused_says_so_in_its_log_and_audit(tmp_path: Path) -> None:
     """Naive placement can put the bell into a distractor, and settling leaves them so: the attempt
     log names the pair and its depth, and the audit counts the accepted episode among those that

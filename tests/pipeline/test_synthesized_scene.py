@@ -102,6 +102,7 @@ def test_bad_scenes_are_typed_errors(scene_dir: Path, tmp_path: Path) -> None:
         assert not (tmp_path / "x").exists()  # nothing written before the refusal
 
 
+@pytest.mark.slow
 def test_every_attempt_can_start_from_a_scene_synthesized_for_it(tmp_path: Path) -> None:
     from vcage.pipeline.episode import attempt
     from vcage.pipeline.generate import generate

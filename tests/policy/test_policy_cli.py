@@ -21,6 +21,7 @@ def flat(text: str) -> str:
     return " ".join(text.split())
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("policy", ["mlp", "diffusion"])
 def test_train_then_evaluate_in_the_datasets_environment(generated: Path, tmp_path: Path,
                                                          policy: str) -> None:

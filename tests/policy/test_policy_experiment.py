@@ -15,7 +15,11 @@ from pathlib import Path
 from types import ModuleType
 from typing import Any
 
+import pytest
+
 from conftest import blocked_modules
+
+pytestmark = pytest.mark.slow  # runs the policy experiment's stages as subprocesses
 
 SCRIPT = Path(__file__).resolve().parents[2] / "benchmarks" / "policy_vcage_vs_vanilla.py"
 

@@ -57,6 +57,7 @@ def test_an_exported_checkpoint_missing_its_ema_is_refused(dataset: Path, tmp_pa
         load_checkpoint(exported)
 
 
+@pytest.mark.slow
 def test_training_needs_neither_the_simulator_nor_the_video_codec(dataset: Path, tmp_path: Path) -> None:
     blocked = blocked_modules(tmp_path / "blocked")
     code = ("import sys; from vcage.policy.train import train; from vcage.policy.config import TrainConfig, "

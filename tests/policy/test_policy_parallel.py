@@ -20,6 +20,8 @@ from vcage.policy.evaluate import evaluate, rollout
 from vcage.policy.inference import PolicyRunner
 from vcage.policy.train import train
 
+pytestmark = pytest.mark.slow  # evaluation rollouts in worker processes
+
 
 @pytest.fixture(scope="module")
 def diffusion_run(generated: Path, tmp_path_factory: pytest.TempPathFactory) -> Path:

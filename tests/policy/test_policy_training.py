@@ -38,6 +38,7 @@ def test_the_mlp_overfits_a_small_dataset(dataset: Path, tmp_path: Path) -> None
     assert summary.samples_per_second > 0 and summary.parameters > 0
 
 
+@pytest.mark.slow
 def test_the_diffusion_policy_overfits_a_small_dataset(dataset: Path, tmp_path: Path) -> None:
     # one U-Net level learns fastest (the multi-level U-Net is exercised by the other tests)
     config = tiny("diffusion", steps=300, checkpoint_every=300, lr=1e-2,

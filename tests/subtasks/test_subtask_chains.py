@@ -142,6 +142,7 @@ def test_the_scene_knows_what_rests_on_what(tmp_path: Path) -> None:
         compose(store, 1, 0)
 
 
+@pytest.mark.slow
 def test_generate_runs_a_chain_of_verified_subtasks(tmp_path: Path) -> None:
     db, out = str(tmp_path / "s.db"), tmp_path / "ds"
     spec = SceneSpec(objects=(ObjectSpec("cube", "block", (0.5, -0.12), color="red"),

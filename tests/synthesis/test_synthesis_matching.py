@@ -48,6 +48,7 @@ def errors(view: TopView, empty: np.ndarray, preset: str, seed: int = 3) -> tupl
     return out, (edit, report)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(("preset", "position", "yaw"), [("none", 0.004, 4.0), ("jpeg", 0.006, 5.0),
                                                          ("color", 0.005, 5.0), ("shift", 0.012, 6.0),
                                                          ("turn", 0.004, 4.0)])
@@ -63,6 +64,7 @@ def test_matching_recovers_the_compositor_ground_truth(scene, preset: str, posit
             assert dyaw <= yaw, (name, dyaw)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("seed", [3, 1])  # seed 1 drops the book, the largest, beside the mouse
 def test_a_dropped_object_is_flagged_lost_and_no_kept_one(scene, seed: int) -> None:
     _, view, empty = scene

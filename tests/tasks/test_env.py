@@ -32,6 +32,7 @@ def test_register_envs_is_idempotent_and_covers_every_task(registered: list[str]
     assert gym.spec(env_id(TASK)).kwargs == {"task": TASK}
 
 
+@pytest.mark.slow
 def test_a_bare_import_registers_the_environments_in_a_fresh_interpreter() -> None:
     code = ("import gymnasium as gym, sys; import vcage; "
             "assert 'mujoco' not in sys.modules, 'registration must not load the simulator'; "

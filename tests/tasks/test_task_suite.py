@@ -46,6 +46,7 @@ def test_every_task_scene_differs_per_seed(name: str) -> None:
     assert len(set(poses)) == 3, name
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", NEW)
 def test_new_experts_succeed_randomised_in_clutter(name: str) -> None:
     result = run_episode(name, seed=3, record=False, scene=SceneConfig(clutter=8))

@@ -48,6 +48,7 @@ def test_unknown_task_lists_valid_names() -> None:
         make_task("fold_laundry")
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", ALL_TASKS)
 def test_expert_succeeds_without_randomization(name: str) -> None:
     result = run_episode(name, seed=0, rand=Randomization.off(), record=False)

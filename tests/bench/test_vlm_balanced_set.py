@@ -13,7 +13,11 @@ import sys
 from pathlib import Path
 from typing import Any
 
+import pytest
+
 from backends.fake_openai import FakeOpenAI, Reply
+
+pytestmark = pytest.mark.slow  # runs a benchmark script over the balanced set
 
 SCRIPT = Path(__file__).resolve().parents[2] / "benchmarks" / "critic_failures.py"
 

@@ -20,6 +20,8 @@ sys.path.insert(0, str(BENCHMARKS))
 from critic_agreement import FUSED  # noqa: E402
 from obs_cache import STAMP, StaleCache, cached, fingerprint, open_cache  # noqa: E402
 
+pytestmark = pytest.mark.slow  # runs a benchmark script over Vanilla rollouts
+
 
 def _agreement(cache: Path) -> subprocess.CompletedProcess[str]:
     script = str(BENCHMARKS / "critic_agreement.py")
