@@ -1,11 +1,15 @@
-"""Does a change leave the data alone? Generate the same datasets with two revisions and compare.
+"""Does a change leave the data alone? Generate the same datasets with two revisions (or one revision
+in two environments) and compare.
 
 Each revision's ``src/`` is exported with ``git archive`` and run through its own command line
-(``python -m vcage.cli generate ...``) in this environment; the datasets are then compared file by
-file: every data parquet, episodes parquet, video, states file and the attempt log must be
-byte-identical (the extras and meta JSON hold the configuration, whose shape may change).
+(``python -m vcage.cli generate ...``) by the interpreter given for it (default: this one); the
+datasets are then compared file by file: every data parquet, episodes parquet, video, states file
+and the attempt log must be byte-identical (the extras and meta JSON hold the configuration and the
+software's versions, whose shape may change).
 
     .venv/bin/python benchmarks/same_data.py --before 636fa76 --after HEAD
+    .venv/bin/python benchmarks/same_data.py --before HEAD --after HEAD \
+        --after-python .venv-latest/bin/python      # the locked versions against the newest (check-latest.sh)
 
 Prints one line per compared file and a summary; exits 1 if any file differs.
 """
@@ -43,10 +47,10 @@ def export(rev: str, into: Path) -> Path:
     return into / "src"
 
 
-def generate(src: Path, out: Path) -> None:
+def generate(src: Path, out: Path, python: str = sys.executable) -> None:
     env = {**os.environ, "PYTHONPATH": str(src)}
     for name, args in RUNS:
-        done = subprocess.run([sys.executable, "-m", "vcage.cli", "generate", *args, "--out",
+        done = subprocess.run([python, "-m", "vcage.cli", "generate", *args, "--out",
                                str(out / name)], env=env, capture_output=True, text=True)
         if done.returncode != 0:
             raise SystemExit(f"{src}: generate {name} failed:\n{done.stdout}\n{done.stderr}")
@@ -73,17 +77,21 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--before", required=True, help="git revision of the reference")
     parser.add_argument("--after", default="HEAD", help="git revision to check (default HEAD)")
+    parser.add_argument("--before-python", default=sys.executable, help="interpreter of the reference")
+    parser.add_argument("--after-python", default=sys.executable, help="interpreter of the one checked")
     args = parser.parse_args()
     with tempfile.TemporaryDirectory(prefix="vcage-same-data-") as tmp:
         root = Path(tmp)
         outs = []
-        for label, rev in (("before", args.before), ("after", args.after)):
+        for label, rev, python in (("before", args.before, args.before_python),
+                                   ("after", args.after, args.after_python)):
             (root / label).mkdir()
-            generate(export(rev, root / label), root / label / "out")
+            generate(export(rev, root / label), root / label / "out", python)
             outs.append(root / label / "out")
         compared, differ = compare(*outs)
     verdict = "all identical" if not differ else f"{differ} differ"
-    print(f"{compared} files compared, {verdict}: {args.before} vs {args.after} "
+    print(f"{compared} files compared, {verdict}: {args.before} ({args.before_python}) vs {args.after} "
+          f"({args.after_python}) "
           f"(runs: {', '.join(name for name, _ in RUNS)})")
     raise SystemExit(1 if differ else 0)
 
