@@ -12,9 +12,11 @@ import numpy as np
 import pytest
 
 from critics.recipes import faulted, observed
+from vcage.critics.base import Observation, View
 from vcage.critics.image import ImageCritic
 from vcage.critics.observation_file import FORMAT, load_observation, save_observation
 from vcage.errors import DatasetError
+from vcage.planning.goals import press
 
 
 def test_an_observation_reads_back_as_it_was_written(tmp_path: Path) -> None:
@@ -39,6 +41,27 @@ def test_an_observation_reads_back_as_it_was_written(tmp_path: Path) -> None:
     critic = ImageCritic()
     assert critic.judge(again).to_dict() == critic.judge(obs).to_dict()
     assert list(tmp_path.iterdir()) == [tmp_path / "x.npz"]  # no temporary file left
+
+
+def test_arrays_keep_their_dtypes_and_values(tmp_path: Path) -> None:
+    """Built here, not read from a stored file: what is written is known independently of the reader."""
+    rng = np.random.default_rng(0)
+    view = View(rgb=rng.integers(0, 256, (6, 8, 3), dtype=np.uint8),
+                segmentation=rng.integers(-2, 3, (6, 8)).astype(np.int32),
+                depth=rng.random((6, 8)).astype(np.float32), pixel_size=0.1 / 3, robot_base=(-12.5, 4.0))
+    deep = replace(view, depth=rng.random((6, 8)))  # float64
+    obs = Observation(subtask=press("bell", "the bell is rung"), labels=("bell",),
+                      before={"top": view}, during={"top": deep}, after={"top": view, "front": view},
+                      types={"bell": "bell"}, oracle={"pressed(bell)": True})
+    save_observation(tmp_path / "x.npz", obs)
+    again, extra = load_observation(tmp_path / "x.npz")
+    assert extra == {} and again.subtask == obs.subtask and again.oracle == obs.oracle
+    for moment, camera in (("before", "top"), ("during", "top"), ("after", "front")):
+        a, b = getattr(obs, moment)[camera], getattr(again, moment)[camera]
+        for name in ("rgb", "segmentation", "depth"):
+            x, y = getattr(a, name), getattr(b, name)
+            assert x.dtype == y.dtype and np.array_equal(x, y), (moment, name)
+        assert (b.pixel_size, b.robot_base) == (0.1 / 3, (-12.5, 4.0))
 
 
 def test_a_view_without_depth_stays_without_it(tmp_path: Path) -> None:

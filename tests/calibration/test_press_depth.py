@@ -1,5 +1,6 @@
-"""The press depth the image critic reads from the top view's depth: its robot constants hold for
-the model, and a full press and a light one fall on either side of its threshold."""
+"""The press depth the image critic reads from the top view's depth, calibrated on the live model (a
+press rolled out in MuJoCo): its robot constants hold for the model, and a full press and a light one
+fall on either side of its threshold."""
 
 from __future__ import annotations
 
