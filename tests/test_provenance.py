@@ -8,6 +8,7 @@ import shutil
 import subprocess
 from pathlib import Path
 
+import vcage
 from vcage import provenance
 from vcage.provenance import LOCK_FILE, code, software, source_digest, versions
 
@@ -23,6 +24,7 @@ def test_the_checkout_s_commit_and_lock_are_recorded() -> None:
     assert recorded["source"] == source_digest()
     assert software() == {**versions(), **recorded}
     assert versions()["mujoco"] == versions()["mujoco-core"]  # released together
+    assert versions()["vcage"] == vcage.__version__  # one version, read by the build from the package
 
 
 def test_the_source_digest_tells_code_apart(tmp_path: Path) -> None:

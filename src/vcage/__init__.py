@@ -25,7 +25,8 @@ from vcage.envs import register_builtin_envs  # noqa: E402
 
 register_builtin_envs()
 
-__version__ = "0.1.0"
+# moves when the episodes a seed gives would differ (0.2.0: installed from requirements/lock.txt)
+__version__ = "0.2.0"
 
 # public name -> module that defines it
 _API = {
