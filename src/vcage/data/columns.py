@@ -19,7 +19,7 @@ import numpy as np
 import pyarrow as pa
 import pyarrow.compute as pc
 
-from vcage.data import layout
+from vcage.data import digest, layout
 from vcage.data import stats as st
 from vcage.data.card import dataset_card
 from vcage.data.files import episodes_table, lock_dir, settle_interrupted, write_json, write_table, write_text
@@ -80,6 +80,10 @@ def add_features(root: str | Path, features: Mapping[str, Feature], values: Valu
                 if key in table.column_names:  # left by an interrupted run: computed again
                     table = table.drop_columns([key])
                 table = table.append_column(key, _column(np.concatenate(columns[key]), feature))
+            for i in episodes:  # the rows' content digests cover the new columns from the commit on
+                if isinstance(rows[i].get(digest.DATA), str):
+                    mine = table.filter(pc.equal(table.column("episode_index"), i))
+                    rows[i][digest.DATA] = digest.of_rows(mine)
             write_table(path, table)
             if progress is not None:
                 progress(done + 1, len(by_file))

@@ -17,6 +17,7 @@ import numpy as np
 import pyarrow as pa
 import pyarrow.parquet as pq
 
+from vcage.data import digest
 from vcage.data import stats as st
 from vcage.data.layout import INFO_PATH, PROVENANCE
 from vcage.errors import DatasetError
@@ -227,12 +228,13 @@ def provenance(extras: dict[str, Any] | None) -> dict[str, Any]:
 
 def episode_row(index: int, task: str, length: int, start: int, *, position: tuple[int, int],
                 video_start: int, chunks_size: int, fps: int, cameras: list[str],
-                stats: dict[str, dict[str, np.ndarray]], extras: dict[str, Any] | None) -> dict[str, Any]:
+                stats: dict[str, dict[str, np.ndarray]], extras: dict[str, Any] | None,
+                digests: dict[str, str] | None = None) -> dict[str, Any]:
     """The ``meta/episodes`` row of episode ``index``, whose frames start at dataset index ``start``.
 
     vcage keeps an episode's data and videos at the same ``position`` (chunk, file); in each video
     file the episode follows ``video_start`` frames of the episodes before it. ``stats`` are its
-    per-episode statistics.
+    per-episode statistics; ``digests`` the content digests of its files (:mod:`vcage.data.digest`).
     """
     chunk, file = position
     row: dict[str, Any] = {
@@ -245,16 +247,20 @@ def episode_row(index: int, task: str, length: int, start: int, *, position: tup
                 f"videos/{key}/to_timestamp": (video_start + length) / fps}
     row |= {"meta/episodes/chunk_index": index // chunks_size, "meta/episodes/file_index": 0}
     row |= provenance(extras)
+    row |= digests or {}
     row |= st.to_row(stats)
     return row
 
 
 def episodes_table(rows: list[dict[str, Any]]) -> pa.Table:
-    """The ``meta/episodes`` table of ``rows``: every row gets the provenance columns (null where
-    unknown, e.g. rows of a dataset written before they existed), typed the same in every file."""
-    rows = [row | {column: row.get(column) for column in PROVENANCE} for row in rows]
+    """The ``meta/episodes`` table of ``rows``: every row gets the provenance columns and the digest
+    columns any row has (null where unknown, e.g. rows of a dataset written before they existed),
+    typed the same in every file."""
+    digests = sorted({c for row in rows for c in row if c.startswith(digest.PREFIX)})
+    rows = [row | {column: row.get(column) for column in (*PROVENANCE, *digests)} for row in rows]
     table = pa.Table.from_pylist(rows)
-    for column, kind in PROVENANCE_TYPES.items():
+    types = PROVENANCE_TYPES | dict.fromkeys(digests, pa.string())
+    for column, kind in types.items():
         i = table.schema.get_field_index(column)
         table = table.set_column(i, column, table.column(column).cast(kind))
     return table

@@ -30,7 +30,7 @@ import numpy as np
 import pyarrow as pa
 import pyarrow.parquet as pq
 
-from vcage.data import layout, video
+from vcage.data import digest, layout, video
 from vcage.data import stats as st
 from vcage.data.card import dataset_card
 from vcage.data.files import (
@@ -412,12 +412,14 @@ class DatasetWriter:
         meta_touched = False
         position, video_start = (0, 0), 0
         try:
-            position, joined = self._write_files(index, table, checked, extras_json if extras else None,
-                                                 states, files, timings)
+            position, joined, digests = self._write_files(index, table, checked,
+                                                          extras_json if extras else None, states, files,
+                                                          timings)
             video_start = self._file_frames if joined else 0
             row = episode_row(index, task, length, self._total_frames, position=position,
                               video_start=video_start, chunks_size=self.chunks_size, fps=self.fps,
-                              cameras=list(self.cameras), stats=episode_stats, extras=extras_json)
+                              cameras=list(self.cameras), stats=episode_stats, extras=extras_json,
+                              digests=digests)
             chunk_rows = [*chunk_rows, row]
             meta_touched = True
             if self._fresh and index == 0:
@@ -463,13 +465,16 @@ class DatasetWriter:
 
     def _write_files(self, index: int, table: pa.Table, checked: dict[str, np.ndarray], extras: Any,
                      states: dict[str, np.ndarray], files: _EpisodeFiles,
-                     timings: dict[str, float] | None = None) -> tuple[tuple[int, int], bool]:
+                     timings: dict[str, float] | None = None
+                     ) -> tuple[tuple[int, int], bool, dict[str, str]]:
         """Data rows, one video per camera (joined to the open files or starting the next), extras
         json and arrays npz; ``files`` records what was created or replaced. Returns the position
-        of the episode's data and video files and whether it joined the open ones."""
+        of the episode's data and video files, whether it joined the open ones, and the digests of
+        what it wrote (:mod:`vcage.data.digest`)."""
         buffer = pa.BufferOutputStream()
         pq.write_table(table, buffer)
         data = buffer.getvalue()
+        digests = {digest.DATA: digest.of_rows(table)}
         encoded: dict[str, Path] = {}
         for key in self.cameras:  # encode first: the sizes decide whether the episode joins the open files
             scratch_dir = self.root / "videos" / key
@@ -480,6 +485,8 @@ class DatasetWriter:
             if timings is not None:
                 timings["encode"] = timings.get("encode", 0.0) + time.perf_counter() - t0
             encoded[key] = tmp
+            window = [(0.0, len(checked[key]) / self.fps)]
+            digests[digest.video_column(key)] = video.packet_digests(tmp, window, self.fps)[0]
         joined = self._joins({"data": data.size, **{k: p.stat().st_size for k, p in encoded.items()}})
         assert self._position is not None or not joined
         position = self._position if joined and self._position is not None else (
@@ -498,18 +505,19 @@ class DatasetWriter:
             else:
                 files.create(path, functools.partial(os.replace, tmp_video))
         if extras is not None:
-            text = json.dumps(extras, indent=1)
+            text = json.dumps(extras, indent=1).encode()
+            digests[digest.EXTRAS] = digest.of_bytes(text)
             files.create(self.root / layout.EXTRAS_PATH.format(episode_index=index),
-                         lambda tmp: tmp.write_text(text))
+                         lambda tmp: tmp.write_bytes(text))
         if states:
-            def save(tmp: Path) -> None:
-                out = io.BytesIO()
-                cast(Any, np.savez_compressed)(out, **states)
-                tmp.write_bytes(out.getvalue())
-
-            files.create(self.root / layout.ARRAYS_PATH.format(episode_index=index), save)
+            out = io.BytesIO()
+            cast(Any, np.savez_compressed)(out, **states)
+            packed = out.getvalue()
+            digests[digest.STATES] = digest.of_bytes(packed)
+            files.create(self.root / layout.ARRAYS_PATH.format(episode_index=index),
+                         lambda tmp: tmp.write_bytes(packed))
         files.remove_scratch()
-        return position, joined
+        return position, joined, digests
 
     def _committed(self, episodes: int) -> bool:
         with contextlib.suppress(Exception):

@@ -18,7 +18,7 @@ from typing import Any
 
 import pyarrow.compute as pc
 
-from vcage.data import layout, video
+from vcage.data import digest, layout, video
 from vcage.data import stats as st
 from vcage.data.card import dataset_card
 from vcage.data.files import (
@@ -279,22 +279,30 @@ def _rebuild_row(root: Path, static: dict[str, Any], tasks: list[str], index: in
     for key, feature in static["features"].items():
         if feature.get("dtype") != "video" and key not in STANDARD_COLUMNS:
             stats[key] = st.vector_stats(column_to_numpy(table.column(key)).reshape(length, -1))
+    # the row is lost with the digests it recorded: they are taken again from the files as they are
+    committed = table.select([n for n in table.column_names if n in static["features"]])
+    digests = {digest.DATA: digest.of_rows(committed)}
     for key in cameras:
         chunk, file = position
-        frames = video.decode_window(
-            root / static["video_path"].format(video_key=key, chunk_index=chunk, file_index=file),
-            video_start / fps, (video_start + length) / fps, fps)
+        path = root / static["video_path"].format(video_key=key, chunk_index=chunk, file_index=file)
+        window = (video_start / fps, (video_start + length) / fps)
+        frames = video.decode_window(path, *window, fps)
         if len(frames) != length:
             raise CorruptDatasetError(f"the video {key} of episode {index} has {len(frames)} frames")
         stats[key] = st.image_stats(frames)
+        digests[digest.video_column(key)] = video.packet_digests(path, [window], fps)[0]
     for key in STANDARD_COLUMNS:
         stats[key] = st.vector_stats(table.column(key).to_numpy())
     extras_path = root / layout.EXTRAS_PATH.format(episode_index=index)
     extras = load_json(extras_path) if extras_path.exists() else None
+    for column, path in ((digest.EXTRAS, extras_path), (digest.STATES, root / layout.ARRAYS_PATH.format(
+            episode_index=index))):
+        if path.is_file():
+            digests[column] = digest.of_file(path)
     start = int(before["dataset_to_index"]) if before is not None else 0
     return episode_row(index, tasks[task_index], length, start, position=position, video_start=video_start,
                        chunks_size=chunks_size, fps=fps, cameras=cameras, stats=stats,
-                       extras=extras if isinstance(extras, dict) else None)
+                       extras=extras if isinstance(extras, dict) else None, digests=digests)
 
 
 def _kept_tasks(tasks: list[str] | None, rows: list[dict[str, Any]]) -> list[str]:

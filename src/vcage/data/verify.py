@@ -25,7 +25,7 @@ import numpy as np
 import pyarrow as pa
 import pyarrow.parquet as pq
 
-from vcage.data import layout, video
+from vcage.data import digest, layout, video
 from vcage.data.files import committed_version
 from vcage.data.reader import NPZ_ERRORS, STANDARD_COLUMNS, load_json, load_npz, read_parquet
 from vcage.errors import CorruptDatasetError, DatasetError
@@ -397,7 +397,7 @@ class Scan:
             if rows != sum(lengths.values()):
                 self._each(path, episodes, f"holds {rows} rows, the episodes need {sum(lengths.values())}")
                 continue
-            if self.decode:
+            if self.decode or any(self._recorded(i, digest.DATA) for i in episodes):
                 self._check_table(path, source, episodes)
 
     def _check_table(self, path: Path, source: Path, episodes: list[int]) -> None:
@@ -407,6 +407,9 @@ class Scan:
         except (OSError, ValueError, KeyError, pa.ArrowException) as exc:
             self._each(path, episodes, f"not a readable parquet file: {_first_line(exc)}")
             return
+        assert self.static is not None
+        # the columns info.json lists: an interrupted `vcage backfill` may have added others
+        committed = table.select([n for n in table.column_names if n in self.static["features"]])
         for i in episodes:
             row = self.rows[i]
             mine = columns["episode_index"] == i
@@ -424,6 +427,9 @@ class Scan:
                 found = set(columns["task_index"][mine].tolist())
                 if found != {self.tasks.index(task)}:
                     self.add(path, i, f"task_index {sorted(found)} does not match its task {task!r}")
+            recorded = self._recorded(i, digest.DATA)
+            if recorded is not None and digest.of_rows(committed.filter(pa.array(mine))) != recorded:
+                self.add(path, i, "its rows' values differ from those written (content digest)")
 
     def _check_videos(self) -> None:
         assert self.static is not None
@@ -447,8 +453,39 @@ class Scan:
                 elif probe.frames != expected:
                     self._each(path, episodes, f"its container holds {probe.frames} frames, the episodes "
                                                f"need {expected}")
-                elif self.decode:
-                    self._check_decoded(path, source, episodes, key, fps)
+                else:
+                    self._check_packets(path, source, episodes, key, fps)
+                    if self.decode:
+                        self._check_decoded(path, source, episodes, key, fps)
+
+    def _recorded(self, episode: int, column: str) -> str | None:
+        """The content digest ``column`` that episode ``episode``'s row recorded, or None."""
+        value = self.rows[episode].get(column) if episode in self.rows else None
+        return value if isinstance(value, str) else None
+
+    def _check_packets(self, path: Path, source: Path, episodes: list[int], key: str, fps: int) -> None:
+        """The encoded packets in each episode's time window against the digest its row recorded."""
+        column = digest.video_column(key)
+        recorded = [(i, self._recorded(i, column)) for i in episodes]
+        recorded = [(i, d) for i, d in recorded if d is not None]
+        windows = []
+        for i, _ in recorded:
+            row, prefix = self.rows[i], f"videos/{key}/"
+            try:
+                window = (float(row[prefix + "from_timestamp"]), float(row[prefix + "to_timestamp"]))
+            except (KeyError, TypeError, ValueError):
+                window = (0.0, 0.0)  # its row's window is damaged: _check_decoded names it
+            windows.append(window)
+        if not recorded:
+            return
+        try:
+            found = video.packet_digests(source, windows, fps)
+        except CorruptDatasetError as exc:
+            self._each(path, [i for i, _ in recorded], _reason(exc))
+            return
+        for (i, want), got in zip(recorded, found, strict=True):
+            if got != want:
+                self.add(path, i, "its encoded frames differ from those written (content digest)")
 
     def _check_decoded(self, path: Path, source: Path, episodes: list[int], key: str, fps: int) -> None:
         try:
@@ -470,18 +507,23 @@ class Scan:
                 self.add(path, i, f"decodes to {decoded} frames in the episode's window, expected {length}")
 
     def _check_extras(self) -> None:
+        """Each episode's extras JSON and states ``.npz``: readable, as long as the episode, and (where
+        its row recorded a digest) present and holding the bytes written. A file's own damage is
+        named first; the digest catches what leaves it readable."""
         for i in range(self.episodes):
             row = self.rows.get(i)
             length = row.get("length") if row is not None else None
             extras = self.root / layout.EXTRAS_PATH.format(episode_index=i)
-            if extras.exists():
+            if self._present(extras, i, digest.EXTRAS):
                 try:
                     if not isinstance(load_json(extras), dict):
                         raise CorruptDatasetError("does not hold a JSON object")
                 except DatasetError as exc:
                     self.add(extras, i, _reason(exc))
+                else:
+                    self._same_bytes(extras, i, digest.EXTRAS)
             arrays = self.root / layout.ARRAYS_PATH.format(episode_index=i)
-            if not arrays.exists():
+            if not self._present(arrays, i, digest.STATES):
                 continue
             try:
                 shapes = ({k: v.shape for k, v in load_npz(arrays).items()} if self.decode else
@@ -494,6 +536,22 @@ class Scan:
             if states is not None and isinstance(length, int) and (not states or states[0] != length):
                 self.add(arrays, i, f"holds {states[0] if states else 0} states, the episode has {length} "
                                     "frames")
+                continue
+            self._same_bytes(arrays, i, digest.STATES)
+
+    def _present(self, path: Path, episode: int, column: str) -> bool:
+        """Whether ``path`` exists; missing where the episode's row recorded its digest is a problem
+        (an episode written without the file records none)."""
+        if path.is_file():
+            return True
+        if self._recorded(episode, column) is not None:
+            self.add(path, episode, "missing (its row records what it held)")
+        return False
+
+    def _same_bytes(self, path: Path, episode: int, column: str) -> None:
+        recorded = self._recorded(episode, column)
+        if recorded is not None and digest.of_file(path) != recorded:
+            self.add(path, episode, "its bytes differ from those written (content digest)")
 
 
 def _npz_shapes(path: Path) -> dict[str, tuple[int, ...]]:

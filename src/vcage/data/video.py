@@ -33,6 +33,13 @@ ENCODER_OPTIONS: dict[str, dict[str, str]] = {
 }
 
 
+def _read_errors() -> tuple[type[BaseException], ...]:
+    """What reading a damaged file raises: PyAV's errors, and an AttributeError where a damaged
+    container gives its stream no codec context (found by the corruption fuzz test)."""
+    import av
+    return (av.FFmpegError, IndexError, OSError, ValueError, AttributeError)
+
+
 def available_encoders() -> list[str]:
     """The preferred encoders this PyAV wheel can actually open for writing, best first."""
     import av
@@ -109,7 +116,7 @@ def decode_video(path: Path) -> tuple[np.ndarray, np.ndarray]:
             for frame in container.decode(stream):
                 frames.append(frame.to_ndarray(format="rgb24"))
                 times.append(float(frame.time) if frame.time is not None else float("nan"))
-    except (av.FFmpegError, IndexError, OSError, ValueError) as exc:
+    except _read_errors() as exc:
         raise CorruptDatasetError(f"cannot decode video {path}: {exc}") from exc
     if not frames:
         raise CorruptDatasetError(f"video {path} holds no frames")
@@ -174,7 +181,7 @@ def probe_video(path: Path) -> Probe:
             if frames <= 0:
                 frames = sum(1 for packet in container.demux(stream) if packet.size)
             return Probe(frames, int(stream.codec_context.height), int(stream.codec_context.width))
-    except (av.FFmpegError, IndexError, OSError, ValueError) as exc:
+    except _read_errors() as exc:
         raise CorruptDatasetError(f"cannot open video {path}: {exc}") from exc
 
 
@@ -190,9 +197,39 @@ def decode_times(path: Path) -> np.ndarray:
             stream = container.streams.video[0]
             for frame in container.decode(stream):
                 times.append(float(frame.time) if frame.time is not None else float("nan"))
-    except (av.FFmpegError, IndexError, OSError, ValueError) as exc:
+    except _read_errors() as exc:
         raise CorruptDatasetError(f"cannot decode video {path}: {exc}") from exc
     return np.asarray(times, dtype=np.float64)
+
+
+def packet_digests(path: Path, windows: list[tuple[float, float]], fps: int) -> list[str]:
+    """A SHA-256 of the encoded bytes of the packets whose timestamps fall in each ``(start, stop)``
+    window (seconds, as an episode's row gives them), read in one pass without decoding.
+
+    :func:`concat_videos` copies packets unchanged, so an episode's digest taken from the file it
+    was encoded to holds in every file it is joined into. CorruptDatasetError if the file cannot
+    be read.
+    """
+    import hashlib
+
+    import av
+    half = 0.5 / fps
+    digests = [hashlib.sha256() for _ in windows]
+    try:
+        with av.open(str(path)) as container:
+            stream = container.streams.video[0]
+            tb = stream.time_base
+            assert tb is not None
+            for packet in container.demux(stream):
+                if packet.pts is None or not packet.size:
+                    continue
+                t = float(packet.pts * tb)
+                for (start, stop), digest in zip(windows, digests, strict=True):
+                    if start - half <= t < stop - half:
+                        digest.update(bytes(packet))
+    except _read_errors() as exc:
+        raise CorruptDatasetError(f"cannot read video {path}: {exc}") from exc
+    return [d.hexdigest() for d in digests]
 
 
 def concat_videos(sources: list[tuple[Path, int]], out: Path, fps: int) -> None:
@@ -237,7 +274,7 @@ def concat_videos(sources: list[tuple[Path, int]], out: Path, fps: int) -> None:
                         packet.stream = target
                         container.mux(packet)
                         copied += 1
-            except (av.FFmpegError, IndexError, OSError, ValueError) as exc:
+            except _read_errors() as exc:
                 raise CorruptDatasetError(f"cannot read video {path}: {exc}") from exc
             if copied != keep:
                 raise CorruptDatasetError(f"video {path} holds {copied} of the {keep} frames to copy")
@@ -262,7 +299,7 @@ def decode_window(path: Path, start: float, stop: float, fps: int) -> np.ndarray
                     break
                 if time >= start - half:
                     frames.append(frame.to_ndarray(format="rgb24"))
-    except (av.FFmpegError, IndexError, OSError, ValueError) as exc:
+    except _read_errors() as exc:
         raise CorruptDatasetError(f"cannot decode video {path}: {exc}") from exc
     if not frames:
         raise CorruptDatasetError(f"video {path} holds no frames between {start:.3f} s and {stop:.3f} s")
