@@ -3,6 +3,7 @@ damage (never "ok", never a traceback), and ``verify --repair`` drops the damage
 
 from __future__ import annotations
 
+import json
 import shutil
 from pathlib import Path
 
@@ -122,3 +123,32 @@ def test_verify_repair_drops_the_damaged_tail_then_everything_passes(ds: Path) -
 def test_verify_of_what_is_not_a_dataset_is_bad_input(tmp_path: Path) -> None:
     result = RUN.invoke(app, ["verify", str(tmp_path / "nothing")])
     assert result.exit_code == 2 and "error:" in result.output
+
+
+def _log_accepted(root: Path, episodes: int = 3) -> None:
+    """The attempt log `vcage generate` writes for the episodes of :func:`make` (seed i for episode i),
+    with a rejected attempt before episode 1's."""
+    records = []
+    for i in range(episodes):
+        if i == 1:
+            records.append({"episode": i, "attempt": 0, "seed": 100, "stage": "critic", "reason": "no",
+                            "oracle_success": False, "audit": [], "verdicts": [], "fused_at_start": []})
+        records.append({"episode": i, "attempt": int(i == 1), "seed": i, "stage": "accepted", "reason": "",
+                        "oracle_success": True, "audit": [], "verdicts": [], "fused_at_start": []})
+    (root / "meta/vcage_attempts.jsonl").write_text("".join(json.dumps(r) + "\n" for r in records))
+
+
+@pytest.mark.parametrize(("damaged", "kept"), [(VIDEO_1, 1), (f"videos/{CAM}/chunk-000/file-000.mp4", 0)])
+def test_audit_and_report_count_only_the_episodes_a_repair_kept(ds: Path, damaged: str, kept: int) -> None:
+    """Found on 2026-12-05: after a repair dropped every episode, `vcage audit` still reported "4
+    accepted episodes of 4 attempts". The audit and the report count the log as the committed
+    episodes hold it, and the repair rewrites the log so."""
+    _log_accepted(ds)
+    assert text(RUN.invoke(app, ["audit", str(ds)])).startswith("3 accepted episodes of 4 attempts")
+    truncate(ds / damaged)
+    assert RUN.invoke(app, ["verify", str(ds), "--repair"]).exit_code == 0
+    result = RUN.invoke(app, ["audit", str(ds)])
+    assert result.exit_code == 0, result.output
+    assert text(result).startswith(f"{kept} accepted episodes of {kept} attempts"), result.output
+    lines = (ds / "meta/vcage_attempts.jsonl").read_text().splitlines()
+    assert [json.loads(line)["seed"] for line in lines] == list(range(kept))

@@ -53,8 +53,9 @@ def strip(root: Path, keys: tuple[str, ...] = (ENVIRONMENT, SUBTASK, ACTION_EE))
         pq.write_table(table.drop_columns([k for k in keys if k in table.column_names]), path)
     for path in (root / "meta/episodes").rglob("*.parquet"):
         table = pq.read_table(path)
-        pq.write_table(table.drop_columns([c for c in table.column_names
-                                           if any(c.startswith(f"stats/{k}/") for k in keys)]), path)
+        pq.write_table(table.drop_columns([c for c in table.column_names  # nor the content digests then
+                                           if any(c.startswith(f"stats/{k}/") for k in keys)
+                                           or c.startswith("vcage/sha256/")]), path)
     info = json.loads((root / INFO_PATH).read_text())
     info["features"] = {k: v for k, v in info["features"].items() if k not in keys}
     (root / INFO_PATH).write_text(json.dumps(info))

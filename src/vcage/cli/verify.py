@@ -20,13 +20,18 @@ def verify_cmd(path: Path = typer.Argument(..., help="a dataset directory"),
                                            "one to the end and rewrite the metadata (says what it drops)")
                ) -> None:
     """Check every episode's files (decoding the videos) and the metadata; fails if anything is damaged."""
+    from vcage.data.layout import ATTEMPTS_LOG
     from vcage.data.repair import repair as repair_dataset
     from vcage.data.verify import verify
+    from vcage.pipeline.attempt_log import reconcile_dataset
 
     if repair:
         result = repair_dataset(path)
         print_problems(result.before)
         console.print(Text(result.summary()))
+        if result.after.ok and reconcile_dataset(path):
+            console.print(f"the attempt log ({ATTEMPTS_LOG}) no longer counts the attempts of the dropped "
+                          "episodes")
         if not result.after.ok:
             print_problems(result.after)
             raise CorruptDatasetError(f"{path} is still damaged after the repair: {result.after.brief()}")

@@ -18,6 +18,7 @@ from pathlib import Path
 from typing import Any
 
 from vcage.data.files import atomic_write
+from vcage.data.layout import ATTEMPTS_LOG
 from vcage.errors import DatasetError
 from vcage.pipeline.stage import Stage
 
@@ -48,19 +49,50 @@ def reconcile(path: Path, committed: Iterable[dict[str, Any]]) -> int:
     atomically if anything changed); returns the first sample index no attempt has used, where the
     next run continues."""
     raw = path.read_text() if path.is_file() else ""
-    records = _parse(path, raw, torn_tail=True)
-    committed = list(committed)
+    kept = reconciled(_parse(path, raw, torn_tail=True), committed)
+    text = "".join(json.dumps(r) + "\n" for r in kept)
+    if text != raw:
+        atomic_write(path, lambda tmp: tmp.write_text(text))
+    return 1 + max((int(r["episode"]) for r in kept), default=-1)
+
+
+def reconciled(records: list[Record], committed: Iterable[dict[str, Any]]) -> list[Record]:
+    """``records`` as the committed episodes' extras ``committed`` hold them: the lines of a sample
+    whose accepted attempt the dataset does not hold (dropped by a repair, or a log edited by hand)
+    are left out, and the lines of committed episodes the log lacks are added from their extras."""
+    committed = [e for e in committed if "seed" in e]  # episodes written by `vcage generate`
     held = {int(e["seed"]) for e in committed}
     orphans = {int(r["episode"]) for r in records
                if r["stage"] == Stage.ACCEPTED and int(r["seed"]) not in held}
     kept = [r for r in records if int(r["episode"]) not in orphans]
     logged = {int(r["seed"]) for r in kept if r["stage"] == Stage.ACCEPTED}
-    restored = [r for e in committed if int(e["seed"]) not in logged for r in e.get("attempts", [])]
-    kept += restored
-    text = "".join(json.dumps(r) + "\n" for r in kept)
-    if text != raw:
-        atomic_write(path, lambda tmp: tmp.write_text(text))
-    return 1 + max((int(r["episode"]) for r in kept), default=-1)
+    return kept + [r for e in committed if int(e["seed"]) not in logged for r in e.get("attempts", [])]
+
+
+def committed_records(root: Path) -> list[Record]:
+    """The attempt log of the dataset at ``root`` as its committed episodes hold it (what
+    :func:`reconcile` would leave, without writing): what ``vcage audit`` and ``vcage report`` count,
+    so that episodes a repair dropped are not counted. DatasetError if the log is corrupt."""
+    from vcage.data.reader import DatasetReader
+
+    path = root / ATTEMPTS_LOG
+    records = read(path, torn_tail=False)
+    reader = DatasetReader(root, videos=False)
+    return reconciled(records, (reader.extras(i) for i in range(reader.num_episodes)))
+
+
+def reconcile_dataset(root: Path) -> bool:
+    """Reconcile the attempt log of the dataset at ``root`` with its committed episodes (after a
+    repair dropped some); whether the log changed. Nothing is done where there is no log."""
+    from vcage.data.reader import DatasetReader
+
+    path = root / ATTEMPTS_LOG
+    if not path.is_file():
+        return False
+    before = path.read_bytes()
+    reader = DatasetReader(root, videos=False)
+    reconcile(path, [reader.extras(i) for i in range(reader.num_episodes)])
+    return path.read_bytes() != before
 
 
 def append(path: Path, records: Iterable[Record]) -> None:

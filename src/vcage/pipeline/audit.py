@@ -15,7 +15,7 @@ from typing import Any
 
 from vcage.data.layout import ATTEMPTS_LOG
 from vcage.errors import DatasetError
-from vcage.pipeline.attempt_log import read
+from vcage.pipeline.attempt_log import committed_records
 from vcage.pipeline.stage import Stage
 
 
@@ -88,7 +88,7 @@ def audit(root: Path) -> AuditReport:
     counts = dict.fromkeys(("attempts", "accepted", "accepted_oracle_failed", "accepted_fused",
                             "accepted_fused_oracle_failed", "judged_subtasks", "true_accept",
                             "false_accept", "false_reject", "true_reject"), 0)
-    for rec in read(path, torn_tail=False):
+    for rec in committed_records(Path(root)):  # the episodes a repair dropped are not counted
         counts["attempts"] += 1
         if rec["stage"] == Stage.ACCEPTED:
             fused = bool(rec.get("fused_at_start"))  # absent from logs written before it was recorded

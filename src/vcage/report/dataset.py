@@ -49,7 +49,7 @@ def open_dataset(root: Path | str) -> RunEvidence:
         raise DatasetError(f"{log} is missing: the report shows the attempts of a dataset made by "
                            "`vcage generate`, and this one was made otherwise or its attempt log was removed")
     try:
-        attempts = attempt_log.read(log, torn_tail=False)
+        attempts = attempt_log.committed_records(root)  # not the attempts of episodes a repair dropped
         runs = attempt_log.read(root / RUNS_LOG, torn_tail=False)
         report_of_audit = audit(root)
     except DatasetError as exc:
