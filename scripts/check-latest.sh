@@ -39,7 +39,7 @@ print(f"  {len(moved)} of {len(locked)} locked packages moved")
 PY
 
 echo "== the test suite under the newest versions"
-LP_NUM_THREADS=1 .venv-latest/bin/pytest -p no:cacheprovider -q -rfE "$@" 2>&1 | tail -n 60
+LP_NUM_THREADS=1 .venv-latest/bin/pytest -p no:cacheprovider -rfE "$@" 2>&1 | tail -n 60
 
 echo "== the same seeds under the locked and the newest versions (benchmarks/same_data.py)"
 .venv/bin/python benchmarks/same_data.py --before HEAD --after HEAD --before-python .venv/bin/python \
