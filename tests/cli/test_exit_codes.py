@@ -70,3 +70,33 @@ def test_an_output_path_under_a_file_is_bad_input(tmp_path: Path) -> None:
     result = RUN.invoke(app, ["generate", "press the bell", "--out", str(a_file / "ds"), *SMALL])
     assert result.exit_code == 2 and result.output.startswith("error:") and "is a file" in result.output
     assert a_file.read_text() == "mine"
+
+
+def _bad_inputs(tmp: Path) -> list[tuple[list[str], str]]:
+    """Ordinary mistakes that ended in a traceback (exit 1) on 2026-12-05, and what the error says."""
+    afile = tmp / "afile"
+    afile.write_text("")
+    binary = tmp / "binary.json"
+    binary.write_bytes(bytes(range(256)))
+    array = tmp / "array.json"
+    array.write_text("[1, 2]")
+    return [
+        (["synthesize", "a mug on a table", "--seed", "-5", "--out", str(tmp / "s")], "--seed"),
+        (["generate", "press the bell", "--seed", "-5", "--out", str(tmp / "g")], "--seed"),
+        (["synthesize", "a mug on a table", "--out", str(afile)], "is a file"),
+        (["generate", "press the bell", "--config", str(binary), "--out", str(tmp / "g")],
+         "cannot read the configuration"),
+        (["generate", "press the bell", "--config", str(array), "--out", str(tmp / "g")],
+         "holds a JSON list, not an object"),
+        (["report", str(tmp / "nothing-yet"), "--out", str(afile / "report.html")], "is a file"),
+    ]
+
+
+def test_ordinary_mistakes_exit_2_with_what_to_change_not_a_traceback(tmp_path: Path) -> None:
+    for args, says in _bad_inputs(tmp_path):
+        result = RUN.invoke(app, args)
+        out = " ".join(result.output.split())
+        assert result.exit_code == 2, (args, result.output, result.exception)
+        assert says in out, (args, out)
+        assert "Traceback" not in out
+    assert not (tmp_path / "s").exists() and not (tmp_path / "g").exists()

@@ -52,7 +52,7 @@ def generate_cmd(
         vote_rule: str = typer.Option(None, help="VLM critic: majority (default) or all"),
         placement: str = typer.Option(None, help="context (default), naive or rejection"),
         clutter: int = typer.Option(None, help="distractors per scene (default 4)"),
-        seed: int = typer.Option(None, help="run seed (default 0)"),
+        seed: int = typer.Option(None, min=0, help="run seed (default 0)"),
         max_attempts: int = typer.Option(None, help="attempts per episode (default 10)"),
         cameras: str = typer.Option(None, help="comma-separated cameras to record (default "
                                     "front,panda/wrist)"),
@@ -159,9 +159,16 @@ def build_config(path: Path | None, mode: str, options: dict[tuple[str, ...], An
     if path is not None:
         try:
             data = json.loads(path.read_text())
-        except (OSError, json.JSONDecodeError) as exc:
-            raise ConfigError(f"cannot read the configuration {path}: {exc}") from None
-        cfg = GenerateConfig.from_dict(data.get("config", {}).get("generate", data))
+        except (OSError, ValueError) as exc:  # ValueError: not JSON, or not text at all
+            raise ConfigError(f"cannot read the configuration {path}: {exc}; give a JSON file such as a "
+                              "dataset's meta/vcage.json") from None
+        nested = data.get("config") if isinstance(data, dict) else None
+        given = nested.get("generate") if isinstance(nested, dict) else data
+        if not isinstance(given, dict):
+            raise ConfigError(f"the configuration {path} holds a JSON {type(given).__name__}, not an object "
+                              "of options; give a dataset's meta/vcage.json or the object under its "
+                              "config.generate")
+        cfg = GenerateConfig.from_dict(given)
     else:
         cfg = presets[mode]()
     tree = cfg.to_dict()

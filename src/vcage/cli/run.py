@@ -25,7 +25,7 @@ DEMO_CLUTTER = 4  # distractors placed around each demo task's objects
 @app.command("run")
 @cli_errors
 def run(task: str = typer.Argument(..., help="atomic task name (see `vcage tasks`)"),
-        episodes: int = typer.Option(1, min=1), seed: int = typer.Option(0),
+        episodes: int = typer.Option(1, min=1), seed: int = typer.Option(0, min=0),
         randomize: bool = typer.Option(True, help="domain randomisation on/off"),
         out: Path = typer.Option(Path("out/run"), help="where images and results go"),
         placement: str = typer.Option("context", help="placement method: context, naive, rejection"),
@@ -39,7 +39,7 @@ def run(task: str = typer.Argument(..., help="atomic task name (see `vcage tasks
 
 @app.command("demo")
 @cli_errors
-def demo(out: Path = typer.Option(Path("out/demo")), seed: int = typer.Option(0),
+def demo(out: Path = typer.Option(Path("out/demo")), seed: int = typer.Option(0, min=0),
          clutter: int = typer.Option(DEMO_CLUTTER, min=0, help="distractors per scene"),
          width: int = typer.Option(320), height: int = typer.Option(240)) -> None:
     """Run a few atomic tasks in cluttered scenes with their scripted experts; write images."""

@@ -17,7 +17,7 @@ SETTLE_SECONDS = 1.0  # a whole second: a cluttered table shows any instability 
 @cli_errors
 def scene(objects: int = typer.Option(20, min=0, help="catalog objects to place as clutter"),
           method: str = typer.Option("context", help="placement method: context, naive, rejection"),
-          seed: int = typer.Option(0), out: Path = typer.Option(Path("out/scene")),
+          seed: int = typer.Option(0, min=0), out: Path = typer.Option(Path("out/scene")),
           width: int = typer.Option(640), height: int = typer.Option(480)) -> None:
     """Instantiate a cluttered table, check it in physics, and render it from the top."""
     import numpy as np

@@ -111,7 +111,7 @@ def show(subtask_id: str = typer.Argument(..., help="an id or a unique prefix of
 @cli_errors
 def chain(db: Path = DB, length: int = typer.Option(3, min=1, max=12, help="subtasks in the chain"),
           scene: str = typer.Option("", help="only this scene id (default: a scene drawn with the seed)"),
-          seed: int = typer.Option(0, help="seed that draws the scene and the chain")) -> None:
+          seed: int = typer.Option(0, min=0, help="seed that draws the scene and the chain")) -> None:
     """Compose a long-horizon chain of verified subtasks and print it as a plan (what `vcage generate
     --subtasks DB --chain LENGTH --seed SEED` runs)."""
     from vcage.subtasks.chains import compose
@@ -130,7 +130,7 @@ def chain(db: Path = DB, length: int = typer.Option(3, min=1, max=12, help="subt
 def export_sft(out: Path = typer.Argument(..., help="directory for train.jsonl, eval.jsonl, split.json"),
                db: Path = DB, eval_share: float = typer.Option(0.2, min=0.0, max=1.0,
                                                                help="share of tasks held out for evaluation"),
-               seed: int = typer.Option(0, help="seed of the task split")) -> None:
+               seed: int = typer.Option(0, min=0, help="seed of the task split")) -> None:
     """Export the accepted programs as prompt-completion JSONL for fine-tuning, split by task."""
     from vcage.subtasks.sft import export_sft as export
     from vcage.subtasks.store import SubtaskStore

@@ -14,7 +14,7 @@ from vcage.cli.errors import cli_errors
 @cli_errors
 def synthesize(prompt: str = typer.Argument(..., help="the scene, e.g. 'organize the breakfast table'"),
                out: Path = typer.Option(Path("out/synthesis"), help="directory for the artefacts"),
-               seed: int = typer.Option(0), attempts: int = typer.Option(3, min=1),
+               seed: int = typer.Option(0, min=0), attempts: int = typer.Option(3, min=1),
                perturb: str = typer.Option("none", help="realism perturbation of the offline goal image: "
                                            "none, shift, color, blur, jpeg, drop, turn, realistic"),
                lam: float = typer.Option(1.0, help="lambda: weight of the semantic cost in the refine step"),

@@ -20,7 +20,7 @@ import pyarrow.parquet as pq
 from vcage.data import digest
 from vcage.data import stats as st
 from vcage.data.layout import INFO_PATH, PROVENANCE
-from vcage.errors import DatasetError
+from vcage.errors import ConfigError, DatasetError
 
 TMP_MARK = ".tmp-"  # temporary files are named .<name>.tmp-<pid>-<random>
 BACKUP_MARK = ".keep-"  # .<name>.keep-<n>: the file as it was with n episodes committed
@@ -118,6 +118,26 @@ def committed_version(path: Path, committed: int) -> Path:
     ``committed`` (which never committed) replaced it and left one, else ``path`` itself."""
     backup = backup_path(path, committed)
     return backup if backup.is_file() else path
+
+
+def check_writable(path: Path, what: str = "--out") -> None:
+    """Raise ConfigError, before any work is done, if the file ``path`` cannot be written: a file
+    where a directory is needed, or a directory that refuses a new file (its missing directories
+    are created)."""
+    for parent in path.parents:
+        if parent.exists():
+            if not parent.is_dir():
+                raise ConfigError(f"cannot write {path}: {parent} is a file; give {what} a path in a "
+                                  "directory")
+            break
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        probe = path.parent / f".{path.name}.{uuid.uuid4().hex}.probe"
+        probe.write_bytes(b"")
+        probe.unlink()
+    except OSError as exc:
+        raise ConfigError(f"cannot write {path}: {exc.strerror or exc}; give {what} a path in a writable "
+                          "directory") from None
 
 
 def write_text(path: Path, text: str) -> None:

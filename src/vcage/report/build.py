@@ -7,7 +7,7 @@ from dataclasses import dataclass
 from importlib.metadata import PackageNotFoundError, version
 from pathlib import Path
 
-from vcage.data.files import atomic_write
+from vcage.data.files import atomic_write, check_writable
 from vcage.errors import ConfigError
 from vcage.report.dataset import open_dataset
 from vcage.report.html import render
@@ -34,6 +34,7 @@ def build_report(datasets: Sequence[Path | str], out: Path | str, limits: Limits
         raise ConfigError(f"{out} is a directory; give --out a file name such as report.html")
     if limits.episodes < 0 or limits.views < 0:
         raise ConfigError(f"limits must be >= 0, got {limits}")
+    check_writable(out)  # before the report is built, which takes a while
     evidence = [open_dataset(root) for root in datasets]  # all checked before any page is drawn
     labels = ["A", "B"] if len(evidence) == 2 else [""]
     pages = tuple(dataset_page(e, key, label, limits)

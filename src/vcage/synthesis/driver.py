@@ -18,7 +18,7 @@ from typing import Any, Protocol
 import numpy as np
 
 from vcage.backends import ChatBackend
-from vcage.errors import PlacementError, SceneError, VcageError
+from vcage.errors import ConfigError, PlacementError, SceneError, VcageError
 from vcage.planning.language import tokens as goal_tokens
 from vcage.planning.offline import OfflinePlanner
 from vcage.scene.instantiate import Instantiator, SceneConfig, SceneInstance
@@ -55,6 +55,12 @@ class DirectorySink:
 
     def __init__(self, root: Path) -> None:
         self.root = Path(root)
+        for parent in (self.root, *self.root.parents):  # before any work: the artefacts need a directory
+            if parent.exists():
+                if not parent.is_dir():
+                    raise ConfigError(f"cannot write the artefacts into {self.root}: {parent} is a file; "
+                                      "give --out a directory")
+                break
 
     def _path(self, name: str) -> Path:
         path = self.root / name
