@@ -20,6 +20,7 @@ from typing import Any, TypeVar
 
 from vcage.critics import Critic
 from vcage.errors import ConfigError
+from vcage.lifetime import die_with_parent
 from vcage.pipeline.config import ExecutorConfig, GenerateConfig
 from vcage.pipeline.sampling import EpisodeRun, build_critic, sample_episode
 from vcage.planning.schema import Plan
@@ -70,7 +71,8 @@ class LocalExecutor(EpisodeExecutor):
                 yield sample_episode(plan, k, cfg, critic)
             return
         context = multiprocessing.get_context("spawn")  # fresh processes: no GL context is forked
-        with ProcessPoolExecutor(self.workers, mp_context=context) as pool:
+        with ProcessPoolExecutor(self.workers, mp_context=context, initializer=die_with_parent,
+                                 initargs=(os.getpid(),)) as pool:
             yield from _in_order(lambda k: pool.submit(_episode, plan, cfg, k), Future.result,
                                  Future.cancel, indices, self.workers)
 

@@ -16,6 +16,7 @@ apart in :attr:`Evaluation.unstable`), and the evaluation goes on: one rollout d
 from __future__ import annotations
 
 import functools
+import os
 import time
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import asdict, dataclass, replace
@@ -27,6 +28,7 @@ import numpy as np
 import torch
 
 from vcage.errors import SimulationError
+from vcage.lifetime import die_with_parent
 from vcage.policy.checkpoint import load_checkpoint
 from vcage.policy.config import ACTION
 from vcage.policy.dataset import FeatureSpec
@@ -377,7 +379,8 @@ class Blocks:
 
 
 def _start_worker(path: str, factory: EnvFactory, config: dict[str, Any], seed: int,
-                  max_steps: int | None, device: str, threads: int) -> None:
+                  max_steps: int | None, device: str, threads: int, parent: int) -> None:
+    die_with_parent(parent)
     torch.set_num_threads(threads)
     _WORKER["blocks"] = Blocks(load_checkpoint(path), factory, config, seed=seed, max_steps=max_steps,
                                device=device)
@@ -399,7 +402,8 @@ def _parallel(path: str, groups: list[list[int]], workers: int, factory: EnvFact
     results: dict[int, EpisodeResult] = {}
     context = multiprocessing.get_context("spawn")  # no forked MuJoCo, GL or torch state
     with ProcessPoolExecutor(workers, mp_context=context, initializer=_start_worker,
-                             initargs=(path, factory, config, seed, max_steps, device, threads)) as pool:
+                             initargs=(path, factory, config, seed, max_steps, device, threads,
+                                       os.getpid())) as pool:
         futures = [pool.submit(_worker_block, group) for group in groups]
         for future in as_completed(futures):
             for k, result in future.result():
