@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import pytest
 from typer.testing import CliRunner
 
 import scripted_critics  # noqa: F401  (registers reject_all)
@@ -100,3 +101,63 @@ def test_ordinary_mistakes_exit_2_with_what_to_change_not_a_traceback(tmp_path: 
         assert says in out, (args, out)
         assert "Traceback" not in out
     assert not (tmp_path / "s").exists() and not (tmp_path / "g").exists()
+
+
+def test_an_outage_mid_run_says_what_the_dataset_holds_and_how_to_continue(tmp_path: Path) -> None:
+    """Found on 2026-12-05: an endpoint that went away mid-run ended with exit 4 and nothing on what
+    the dataset held or how to continue, and no entry in the runs log."""
+    import json
+
+    from backends.fake_openai import FakeOpenAI
+
+    out = tmp_path / "ds"
+    yes = json.dumps({"success": True, "reason": "the bell was pressed"})
+    with FakeOpenAI("fake-vlm") as server:
+        server.script(yes)  # the first episode's one subtask; then every request fails (500)
+        result = RUN.invoke(app, ["generate", "press the bell", "--episodes", "3", "--out", str(out),
+                                  "--critic", "vlm", "--critic-url", server.base_url, "--critic-model",
+                                  "fake-vlm", "--votes", "1", "--critic-retries", "0", *SMALL])
+    said = " ".join(result.output.split())
+    assert result.exit_code == 4, result.output
+    assert "holds 1 committed episodes, intact" in said and "--total --episodes 3" in said, said
+    [run] = [json.loads(line) for line in (out / "meta/vcage_runs.jsonl").read_text().splitlines()]
+    assert run["ended"].startswith("failed: ") and run["dataset_episodes"] == 1
+
+
+def test_a_run_that_commits_nothing_does_not_claim_a_log_it_did_not_write(tmp_path: Path) -> None:
+    out = tmp_path / "ds"
+    result = RUN.invoke(app, ["generate", "press the bell", "--episodes", "1", "--out", str(out),
+                              "--critic", "reject_all", "--max-attempts", "1", *SMALL])
+    said = " ".join(result.output.split())
+    assert result.exit_code == 3 and "nothing was committed" in said and "appended" not in said, said
+    assert not out.exists()
+
+
+@pytest.mark.slow
+def test_ctrl_c_says_what_the_dataset_holds_and_logs_the_run(tmp_path: Path) -> None:
+    import json
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    out = tmp_path / "ds"
+    args = ["generate", "press the bell", "--episodes", "50", "--out", str(out), "--critic", "oracle", *SMALL]
+    run = subprocess.Popen([sys.executable, "-m", "vcage.cli", *args], stdout=subprocess.PIPE,
+                           stderr=subprocess.STDOUT, text=True)
+    deadline = time.monotonic() + 120
+    while time.monotonic() < deadline and run.poll() is None:
+        try:
+            if json.loads((out / "meta/info.json").read_text())["total_episodes"] >= 1:
+                break
+        except (OSError, ValueError, KeyError):
+            pass
+        time.sleep(0.2)
+    run.send_signal(signal.SIGINT)
+    said = " ".join(run.communicate(timeout=60)[0].split())
+    held = json.loads((out / "meta/info.json").read_text())["total_episodes"]
+    assert run.returncode == 130, said
+    assert f"interrupted: the dataset in {out}/ holds {held} committed episodes" in said
+    assert "--total --episodes 50" in said
+    last = json.loads((out / "meta/vcage_runs.jsonl").read_text().splitlines()[-1])
+    assert last["ended"] == "interrupted" and last["dataset_episodes"] == held

@@ -13,8 +13,8 @@ from rich.table import Table
 from rich.text import Text
 
 from vcage.cli._app import app, console
-from vcage.cli.errors import EXIT_PARTIAL, cli_errors, fail
-from vcage.errors import ConfigError
+from vcage.cli.errors import EXIT_PARTIAL, cli_errors, exit_code, fail
+from vcage.errors import BackendError, ConfigError
 
 if TYPE_CHECKING:
     from vcage.pipeline.config import GenerateConfig
@@ -128,8 +128,20 @@ def generate_cmd(
         bar.update(job, completed=f.accepted + f.given_up,
                    description=f"episodes (attempts {f.attempts}, accepted {f.accepted})")
 
+    target = episodes if total else _committed(out) + episodes  # what --total continues to
     try:
         funnel = generate(instruction, episodes, out, cfg, progress=update, plan=plan, total=total)
+    except KeyboardInterrupt:
+        if job is not None:
+            bar.stop()
+        console.print(f"interrupted: {_holds(out)}; to continue, run the same command with --total "
+                      f"--episodes {target}", highlight=False)
+        raise typer.Exit(130) from None
+    except BackendError as exc:  # an endpoint that went away mid-run
+        if job is not None:
+            bar.stop()
+        fail(f"{exc}; {_holds(out)}; once the endpoint answers, run the same command with --total "
+             f"--episodes {target}", exit_code(exc))
     finally:
         if job is not None:
             bar.stop()
@@ -278,5 +290,28 @@ def print_funnel(stats: dict, out: Path) -> None:
         f"{stats['label_noise']:.1%}; {stats['wall_seconds']:.1f} s wall, "
         f"{stats['episodes_per_hour']:.0f} episodes/hour on {stats['workers']} worker(s) "
         f"({stats['episodes_per_core_hour']:.0f} per core-hour){timing}")
-    console.print(f"the dataset in {out}/ holds {stats['dataset_episodes']} episodes; this run's funnel "
-                  "is appended to meta/vcage_runs.jsonl")
+    if stats["dataset_episodes"]:
+        console.print(f"the dataset in {out}/ holds {stats['dataset_episodes']} episodes; this run's funnel "
+                      "is appended to meta/vcage_runs.jsonl")
+    else:
+        console.print(f"nothing was committed, so {out}/ holds no dataset and no log of this run")
+
+
+def _committed(out: Path) -> int:
+    """The episodes the dataset at ``out`` holds (its commit point), 0 where there is none."""
+    import json
+
+    from vcage.data.layout import INFO_PATH
+
+    try:
+        return int(json.loads((out / INFO_PATH).read_text())["total_episodes"])
+    except (OSError, ValueError, KeyError, TypeError):
+        return 0
+
+
+def _holds(out: Path) -> str:
+    n = _committed(out)
+    if not n:
+        return f"nothing was committed: {out}/ holds no dataset"
+    return (f"the dataset in {out}/ holds {n} committed episodes, intact (this run's funnel is in "
+            "meta/vcage_runs.jsonl)")

@@ -23,7 +23,7 @@ from typing import Any
 
 from vcage.data import DatasetReader, DatasetWriter
 from vcage.data.layout import ATTEMPTS_LOG, RUNS_LOG
-from vcage.errors import ConfigError
+from vcage.errors import ConfigError, VcageError
 from vcage.pipeline import attempt_log, critic_views
 from vcage.pipeline.config import GenerateConfig
 from vcage.pipeline.episode import Timing
@@ -116,16 +116,25 @@ def generate(instruction: str, episodes: int, out: Path | str, cfg: GenerateConf
         first = log.next_sample
         if progress is not None:
             progress(funnel)  # everything is checked: the episodes start
-        for run in pool.runs(plan, cfg, range(first, first + funnel.episodes_requested), critic):
-            _record(writer, log, plan, run, funnel)
+        ended = "complete"
+        try:
+            for run in pool.runs(plan, cfg, range(first, first + funnel.episodes_requested), critic):
+                _record(writer, log, plan, run, funnel)
+                funnel.wall = time.perf_counter() - t0
+                if progress is not None:
+                    progress(funnel)
+        except KeyboardInterrupt:
+            ended = "interrupted"
+            raise
+        except VcageError as exc:  # e.g. the critic's endpoint went away mid-run
+            ended = f"failed: {exc}"
+            raise
+        finally:  # the committed episodes are intact whatever ended the run: its entry says how it ended
+            funnel.dataset_episodes = writer.num_episodes
             funnel.wall = time.perf_counter() - t0
-            if progress is not None:
-                progress(funnel)
-        funnel.dataset_episodes = writer.num_episodes
-        funnel.wall = time.perf_counter() - t0
-        if writer.num_episodes:
-            attempt_log.append(out / RUNS_LOG, [{"instruction": plan.instruction, **funnel.to_dict(),
-                                                  "software": software()}])
+            if writer.num_episodes:
+                attempt_log.append(out / RUNS_LOG, [{"instruction": plan.instruction, **funnel.to_dict(),
+                                                      "ended": ended, "software": software()}])
     return funnel
 
 
