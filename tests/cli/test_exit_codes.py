@@ -83,7 +83,7 @@ def _bad_inputs(tmp: Path) -> list[tuple[list[str], str]]:
     array.write_text("[1, 2]")
     return [
         (["synthesize", "a mug on a table", "--seed", "-5", "--out", str(tmp / "s")], "--seed"),
-        (["generate", "press the bell", "--seed", "-5", "--out", str(tmp / "g")], "--seed"),
+        (["generate", "press the bell", "--seed", "-5", "--out", str(tmp / "g")], "seed must be"),
         (["synthesize", "a mug on a table", "--out", str(afile)], "is a file"),
         (["generate", "press the bell", "--config", str(binary), "--out", str(tmp / "g")],
          "cannot read the configuration"),

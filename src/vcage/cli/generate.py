@@ -52,7 +52,7 @@ def generate_cmd(
         vote_rule: str = typer.Option(None, help="VLM critic: majority (default) or all"),
         placement: str = typer.Option(None, help="context (default), naive or rejection"),
         clutter: int = typer.Option(None, help="distractors per scene (default 4)"),
-        seed: int = typer.Option(None, min=0, help="run seed (default 0)"),
+        seed: int = typer.Option(None, help="run seed (default 0)"),
         max_attempts: int = typer.Option(None, help="attempts per episode (default 10)"),
         cameras: str = typer.Option(None, help="comma-separated cameras to record (default "
                                     "front,panda/wrist)"),

@@ -22,7 +22,7 @@ def train_cmd(
         steps: int = typer.Option(None, help="optimiser steps in all (default 15000)"),
         batch_size: int = typer.Option(None, help="samples per step (default 64)"),
         lr: float = typer.Option(None, help="peak learning rate (default 1e-3)"),
-        seed: int = typer.Option(None, min=0, help="seed of the weights, batches and noise (default 0)"),
+        seed: int = typer.Option(None, help="seed of the weights, batches and noise (default 0)"),
         checkpoint_every: int = typer.Option(None, help="steps between checkpoints (default 1000)"),
         obs: str = typer.Option(None, help="comma-separated observation features (default: "
                                 "observation.state, observation.ee_pose and observation.environment_state "
