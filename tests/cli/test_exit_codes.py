@@ -90,6 +90,7 @@ def _bad_inputs(tmp: Path) -> list[tuple[list[str], str]]:
         (["generate", "press the bell", "--config", str(array), "--out", str(tmp / "g")],
          "holds a JSON list, not an object"),
         (["report", str(tmp / "nothing-yet"), "--out", str(afile / "report.html")], "is a file"),
+        (["train", str(afile), "--out", str(tmp / "r")], "is a file, not a dataset directory"),  # was exit 5
     ]
 
 
@@ -161,3 +162,14 @@ def test_ctrl_c_says_what_the_dataset_holds_and_logs_the_run(tmp_path: Path) -> 
     assert "--total --episodes 50" in said
     last = json.loads((out / "meta/vcage_runs.jsonl").read_text().splitlines()[-1])
     assert last["ended"] == "interrupted" and last["dataset_episodes"] == held
+
+
+def test_a_table_too_full_to_place_advises_less_clutter_not_more_attempts(tmp_path: Path) -> None:
+    """Found on 2026-12-05: --clutter 500 failed every attempt at placement and advised raising
+    --max-attempts, which cannot help."""
+    out = tmp_path / "ds"
+    result = RUN.invoke(app, ["generate", "press the bell", "--episodes", "1", "--out", str(out), "--clutter",
+                              "500", "--size", "64", "--cameras", "front", "--max-attempts", "2"])
+    said = " ".join(result.output.split())
+    assert result.exit_code == 3, said
+    assert "lower --clutter" in said and "raise --max-attempts" not in said

@@ -110,6 +110,8 @@ def test_a_colour_the_instruction_gives_is_set_on_the_goals_object() -> None:
 @pytest.mark.parametrize("text, message", [
     ("clean the desk and the kitchen", "also asks for desk"),  # before: tidy_the_kitchen
     ("make breakfast and serve tea", "also asks for breakfast"),  # before: serve_tea
+    # every goal the extra word belongs to is named (before: only the last, tidy_the_coffee_corner)
+    ("get the table ready for a cup of tea", "also asks for tea, words of serve_tea, tidy_the_coffee_corner"),
     ("shut down the laptop for the night", "'the laptop' is not an object"),  # before: shut_down_...
     ("make breakfast twice", "'twice' asks for a number"),
     ("don't press the bell", "what not to do"),

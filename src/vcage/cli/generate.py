@@ -149,8 +149,7 @@ def generate_cmd(
     if funnel.accepted < funnel.episodes_requested:
         fail(f"only {funnel.accepted} of the {funnel.episodes_requested} episodes asked for were "
              f"accepted ({funnel.given_up} given up after {cfg.max_attempts} attempts each); the "
-             f"dataset holds {funnel.dataset_episodes}: rerun with --total to complete it, or raise "
-             "--max-attempts", EXIT_PARTIAL)
+             f"dataset holds {funnel.dataset_episodes}: {_advice(dict(funnel.stages))}", EXIT_PARTIAL)
 
 
 def build_config(path: Path | None, mode: str, options: dict[tuple[str, ...], Any],
@@ -295,6 +294,21 @@ def print_funnel(stats: dict, out: Path) -> None:
                       "is appended to meta/vcage_runs.jsonl")
     else:
         console.print(f"nothing was committed, so {out}/ holds no dataset and no log of this run")
+
+
+def _advice(stages: dict[str, int]) -> str:
+    """What to change after a run that fell short, from where its attempts ended: more attempts help
+    where they fail by chance, not where every one fails at the same stage for a reason of the scene."""
+    rejected = {stage: n for stage, n in stages.items() if stage != "accepted" and n}
+    if stages.get("accepted"):
+        return "rerun with --total to complete it, or raise --max-attempts"
+    if set(rejected) == {"placement"}:
+        return ("every attempt failed to place the objects (no free space for them, see the reasons "
+                "above): lower --clutter or ask for fewer objects; more attempts will not help")
+    if set(rejected) == {"scene"}:
+        return ("every placed scene failed the physics check (see the reasons above): lower --clutter; "
+                "more attempts will not help")
+    return "rerun with --total to complete it, or raise --max-attempts"
 
 
 def _committed(out: Path) -> int:

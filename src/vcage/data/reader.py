@@ -136,6 +136,10 @@ class DatasetReader:
     def __init__(self, root: str | Path, *, videos: bool = True) -> None:
         self.root = Path(root)
         self.videos = videos
+        if not self.root.is_dir():  # bad input, not a damaged dataset
+            what = "a file" if self.root.exists() else "missing"
+            raise DatasetError(f"{self.root} is {what}, not a dataset directory; give the directory a "
+                               "dataset was written to")
         self.info: dict[str, Any] = load_json(self.root / INFO_PATH)
         try:
             self._parse_info()

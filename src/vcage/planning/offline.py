@@ -406,10 +406,13 @@ class OfflinePlanner:
                                 f"word it matched ({', '.join(sorted(best.evidence))}); say which. "
                                 f"{self.capabilities()}")
         goal = self.goals[best.label]
-        extra = {t: g for t in set(tokens(text)) - self.matcher.vocabulary_of(goal.name)
-                 for g, name in self._name_words.items() if g != goal.name and t in name}
+        extra: dict[str, set[str]] = {}  # word -> every other goal whose name holds it
+        for t in set(tokens(text)) - self.matcher.vocabulary_of(goal.name):
+            for g, name in self._name_words.items():
+                if g != goal.name and t in name:
+                    extra.setdefault(t, set()).add(g)
         if extra:  # "clean the desk and the kitchen", "make breakfast and serve tea"
-            also = sorted(set(extra.values()))
+            also = sorted(set().union(*extra.values()))
             raise PlanningError(f"{fail}: it fits {goal.name} ({best.score:.2f}) but also asks for "
                                 f"{', '.join(sorted(extra))}, words of {listed(also, 3)} that {goal.name} "
                                 f"does not cover; give one goal per instruction. {self.capabilities()}")
