@@ -152,3 +152,23 @@ def test_audit_and_report_count_only_the_episodes_a_repair_kept(ds: Path, damage
     assert text(result).startswith(f"{kept} accepted episodes of {kept} attempts"), result.output
     lines = (ds / "meta/vcage_attempts.jsonl").read_text().splitlines()
     assert [json.loads(line)["seed"] for line in lines] == list(range(kept))
+
+
+def test_a_corrupt_attempt_log_is_damage_to_every_command_and_repair_sets_its_lines_aside(ds: Path) -> None:
+    """Found on 2026-12-05: a corrupt attempt log exited 2 in audit, 5 in report, and verify did not
+    see it."""
+    _log_accepted(ds)
+    log = ds / "meta/vcage_attempts.jsonl"
+    lines = log.read_text().splitlines(keepends=True)
+    lines[1] = lines[1][: len(lines[1]) // 2] + "\n"  # a line torn in the middle of the log
+    log.write_text("".join(lines))
+    for verb in ("verify", "audit", "report"):
+        result = RUN.invoke(app, [verb, str(ds), *(["--out", str(ds.parent / "r.html")] if verb == "report"
+                                                    else [])])
+        assert result.exit_code == 5 and "vcage_attempts.jsonl" in text(result), (verb, result.output)
+    repaired = RUN.invoke(app, ["verify", str(ds), "--repair"])
+    assert repaired.exit_code == 0, repaired.output
+    [aside] = list((ds / "meta").glob("vcage_attempts.jsonl.damaged-*"))
+    assert aside.read_text() == lines[1] and log.read_text() == "".join(lines[:1] + lines[2:])
+    assert DatasetReader(ds).num_episodes == 3  # no episode was lost
+    assert RUN.invoke(app, ["audit", str(ds)]).exit_code == 0

@@ -11,6 +11,7 @@ from __future__ import annotations
 import contextlib
 import functools
 import os
+import time
 from collections import defaultdict
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -36,7 +37,7 @@ from vcage.data.files import (
     write_text,
 )
 from vcage.data.reader import NPZ_ERRORS, STANDARD_COLUMNS, column_to_numpy, load_json, read_parquet
-from vcage.data.verify import Scan, VerifyReport, span, verify
+from vcage.data.verify import Scan, VerifyReport, bad_log_lines, span, verify
 from vcage.errors import CorruptDatasetError, DatasetError
 
 
@@ -140,7 +141,8 @@ def _rewrite(scan: Scan, before: VerifyReport, found: VerifyReport, kept: int,
             "splits": {"train": f"0:{kept}"}}
     keep = _files_of(scan, range(kept))
     doomed = _files_of(scan, range(kept, scan.episodes))
-    rewritten = [*_cut_shared(scan, kept, sorted(keep & doomed)), layout.INFO_PATH]
+    rewritten = [*_cut_shared(scan, kept, sorted(keep & doomed)), *_set_aside_bad_lines(root),
+                 layout.INFO_PATH]
     write_json(root / layout.INFO_PATH, info)  # the commit point: nothing beyond is read now
     stats: dict[str, st.Stats] = {}
     for row in rows:
@@ -194,6 +196,23 @@ def _rewrite(scan: Scan, before: VerifyReport, found: VerifyReport, kept: int,
     return RepairReport(root, before, verify(root), kept, dropped,
                         tuple(i for i in dropped if i not in damaged), tuple(rewritten), tuple(removed),
                         {i: reasons[i] for i in dropped if i in damaged}, rebuilt)
+
+
+def _set_aside_bad_lines(root: Path) -> list[str]:
+    """Rewrite each vcage log without the lines that are not JSON, which go to a ``.damaged-<time>``
+    file beside it (nothing is deleted); the logs rewritten."""
+    out = []
+    for rel in (layout.ATTEMPTS_LOG, layout.RUNS_LOG):
+        path = root / rel
+        bad = set(bad_log_lines(path))
+        if not bad:
+            continue
+        lines = path.read_text(errors="replace").splitlines(keepends=True)
+        stamp = time.strftime("%Y%m%d-%H%M%S")
+        write_text(path.with_name(f"{path.name}.damaged-{stamp}"), "".join(lines[i] for i in sorted(bad)))
+        write_text(path, "".join(line for i, line in enumerate(lines) if i not in bad))
+        out.append(rel)
+    return out
 
 
 def _beyond(found: tuple[str, tuple[int, int]], last: dict[str, Any] | None) -> bool:

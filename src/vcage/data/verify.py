@@ -15,6 +15,7 @@ an interrupted episode had already replaced is checked in the backup holding its
 
 from __future__ import annotations
 
+import json
 import zipfile
 from collections import defaultdict
 from dataclasses import dataclass
@@ -203,6 +204,7 @@ class Scan:
         self._check_data()
         self._check_videos()
         self._check_extras()
+        self._check_logs()
         return self
 
     def _read_marker(self, path: Path) -> None:
@@ -506,6 +508,15 @@ class Scan:
             if decoded != length:
                 self.add(path, i, f"decodes to {decoded} frames in the episode's window, expected {length}")
 
+    def _check_logs(self) -> None:
+        """vcage's JSON-lines logs: every line but the last is JSON (a crash tears only the last one,
+        which the next writer drops)."""
+        for rel in (layout.ATTEMPTS_LOG, layout.RUNS_LOG):
+            bad = bad_log_lines(self.root / rel)
+            if bad:
+                self.add(self.root / rel, None, f"{len(bad)} line(s) are not JSON (the first: line "
+                                                f"{bad[0] + 1}); `vcage verify --repair` sets them aside")
+
     def _check_extras(self) -> None:
         """Each episode's extras JSON and states ``.npz``: readable, as long as the episode, and (where
         its row recorded a digest) present and holding the bytes written. A file's own damage is
@@ -552,6 +563,21 @@ class Scan:
         recorded = self._recorded(episode, column)
         if recorded is not None and digest.of_file(path) != recorded:
             self.add(path, episode, "its bytes differ from those written (content digest)")
+
+
+def bad_log_lines(path: Path) -> list[int]:
+    """The indices of the lines of the JSON-lines file ``path`` that are not JSON, its last line left
+    out (a crash while appending tears it; the writer drops it); [] if there is no file."""
+    if not path.is_file():
+        return []
+    lines = path.read_text(errors="replace").splitlines()
+    bad = []
+    for n, line in enumerate(lines[:-1]):
+        try:
+            json.loads(line)
+        except ValueError:
+            bad.append(n)
+    return bad
 
 
 def _npz_shapes(path: Path) -> dict[str, tuple[int, ...]]:

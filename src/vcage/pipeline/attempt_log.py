@@ -19,7 +19,7 @@ from typing import Any
 
 from vcage.data.files import atomic_write
 from vcage.data.layout import ATTEMPTS_LOG
-from vcage.errors import DatasetError
+from vcage.errors import CorruptDatasetError
 from vcage.pipeline.stage import Stage
 
 Record = dict[str, Any]
@@ -40,7 +40,8 @@ def _parse(path: Path, text: str, torn_tail: bool) -> list[Record]:
         except json.JSONDecodeError:
             if torn_tail and n == len(lines):  # the line was never complete
                 break
-            raise DatasetError(f"{path} line {n} is not JSON; the log is corrupt") from None
+            raise CorruptDatasetError(f"{path} line {n} is not JSON; the log is corrupt (a crash tears only "
+                                      "the last line)") from None
     return records
 
 
