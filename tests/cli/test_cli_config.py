@@ -90,3 +90,27 @@ def test_timeouts_and_retries_are_options_and_override_a_config_file(
         ("env-model", 9.0, 0)
     with pytest.raises(ConfigError, match="timeout"):
         build_config(path, "vcage", {}, {"critic": ("VCAGE_VLM", {"timeout": -1.0})})
+
+
+def test_a_server_that_lists_no_models_is_used_with_the_preflight_off(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Found on 2026-12-05: a server that answers chat but not ``GET /models`` could not be used at
+    all; the check before any work is now an option (and ``$VCAGE_VLM_PREFLIGHT``)."""
+    from backends.fake_openai import Status
+
+    args = ["generate", "press the bell", "--episodes", "1", "--critic", "vlm", "--critic-model", "fake-vlm",
+            "--votes", "1", "--critic-retries", "0", *SMALL]
+    with FakeOpenAI("fake-vlm") as server:
+        server.listing_error = Status(404, "no such route")
+        server.script(*([YES] * 4))
+        refused = RUN.invoke(app, [*args, "--out", str(tmp_path / "a"), "--critic-url", server.base_url])
+        assert refused.exit_code == 4 and not (tmp_path / "a").exists(), refused.output
+        made = RUN.invoke(app, [*args, "--out", str(tmp_path / "b"), "--critic-url", server.base_url,
+                                "--no-critic-preflight"])
+        assert made.exit_code == 0, made.output
+        monkeypatch.setenv("VCAGE_VLM_PREFLIGHT", "0")
+        server.script(*([YES] * 4))
+        again = RUN.invoke(app, [*args, "--out", str(tmp_path / "c"), "--critic-url", server.base_url])
+        assert again.exit_code == 0, again.output
+    critic = json.loads((tmp_path / "b" / VCAGE_PATH).read_text())["config"]["generate"]["critic"]
+    assert critic["name"] == "vlm" and "preflight" not in critic["backend"]  # how it is reached: not compared

@@ -71,8 +71,8 @@ class ChatBackend(ABC):
         the cause (connection refused, timeout, HTTP status and the server's message, or the models
         the server does serve). Providers without a probe (see :meth:`_probe`) check nothing.
         """
-        if type(self)._probe is ChatBackend._probe:
-            return  # this provider has no probe: nothing is sent, nothing checked
+        if type(self)._probe is ChatBackend._probe or not self.config.preflight:
+            return  # this provider has no probe, or the config says not to: nothing is sent, nothing checked
         cfg = self.config
         url = self.probe_url
         self._count(requests=1)

@@ -45,6 +45,9 @@ class BackendConfig:
     breaker_failures: int = 3  # failed requests in a row (after their retries) that open the circuit
     temperature: float = 0.0
     max_tokens: int | None = 1024
+    # ask the endpoint before any work whether it answers and serves the model (``GET /models`` for
+    # OpenAI-compatible servers); off for servers that do not list their models
+    preflight: bool = True
 
     def __post_init__(self) -> None:
         parts = urlsplit(self.base_url) if isinstance(self.base_url, str) else None
@@ -70,6 +73,8 @@ class BackendConfig:
         breaker = self.breaker_failures
         if isinstance(breaker, bool) or not isinstance(breaker, int) or breaker < 1:
             raise ConfigError(f"breaker_failures must be an integer >= 1, got {self.breaker_failures!r}")
+        if not isinstance(self.preflight, bool):
+            raise ConfigError(f"preflight must be true or false, got {self.preflight!r}")
         if self.max_tokens is not None and (
             isinstance(self.max_tokens, bool) or not isinstance(self.max_tokens, int) or self.max_tokens < 1
         ):
@@ -124,8 +129,9 @@ class BackendConfig:
         vLLM's default, for openai; Google's API for gemini); ``VCAGE_LLM_MODEL`` is required. When
         ``VCAGE_LLM_API_KEY`` is set, ``api_key_env`` names it, so the key is read from the
         environment when a request is made and never stored in the config; otherwise the
-        provider's usual variable is used (``OPENAI_API_KEY``, ``GEMINI_API_KEY``). ``overrides``
-        set any other field. The defaults are the ones the provider was registered with.
+        provider's usual variable is used (``OPENAI_API_KEY``, ``GEMINI_API_KEY``).
+        ``VCAGE_LLM_PREFLIGHT=0`` skips the check before any work (for servers that list no models).
+        ``overrides`` set any other field. The defaults are the ones the provider was registered with.
         """
         env = os.environ if environ is None else environ
         provider = overrides.pop("provider", None) or env.get(f"{prefix}_PROVIDER") or "openai"
@@ -138,6 +144,12 @@ class BackendConfig:
         data: dict[str, Any] = {"base_url": base_url, "model": model, "provider": provider}
         if env.get(f"{prefix}_API_KEY"):
             data["api_key_env"] = f"{prefix}_API_KEY"
+        flag = env.get(f"{prefix}_PREFLIGHT", "").strip().lower()
+        if flag:
+            if flag not in ("0", "1", "true", "false", "yes", "no"):
+                raise ConfigError(f"{prefix}_PREFLIGHT={flag!r}: use 0 (skip the check of the endpoint "
+                                  "before any work) or 1")
+            data["preflight"] = flag in ("1", "true", "yes")
         data.update(overrides)
         return cls.from_dict(data)
 

@@ -41,6 +41,9 @@ def generate_cmd(
         planner_provider: str = typer.Option(None, help="openai (any compatible server) or gemini"),
         planner_timeout: float = typer.Option(None, help="seconds per LLM request (default 30)"),
         planner_retries: int = typer.Option(None, help="retries of a failed LLM request (default 3)"),
+        planner_preflight: bool = typer.Option(None, "--planner-preflight/--no-planner-preflight",
+                                               help="check the LLM endpoint before any work (default on; off "
+                                               "for servers that list no models; else $VCAGE_LLM_PREFLIGHT)"),
         critic: str = typer.Option(None, help="critic that verifies each subtask: image (default, "
                                    "offline), vlm, oracle"),
         critic_model: str = typer.Option(None, help="VLM critic's model (else $VCAGE_VLM_MODEL)"),
@@ -48,6 +51,9 @@ def generate_cmd(
         critic_provider: str = typer.Option(None, help="openai (any compatible server) or gemini"),
         critic_timeout: float = typer.Option(None, help="seconds per VLM request (default 30)"),
         critic_retries: int = typer.Option(None, help="retries of a failed VLM request (default 3)"),
+        critic_preflight: bool = typer.Option(None, "--critic-preflight/--no-critic-preflight",
+                                              help="check the VLM endpoint before any work (default on; off "
+                                              "for servers that list no models; else $VCAGE_VLM_PREFLIGHT)"),
         votes: int = typer.Option(None, help="VLM critic: answers asked per subtask (default 1)"),
         vote_rule: str = typer.Option(None, help="VLM critic: majority (default) or all"),
         placement: str = typer.Option(None, help="context (default), naive or rejection"),
@@ -90,9 +96,10 @@ def generate_cmd(
         ("executor", "name"): executor, ("executor", "workers"): workers, ("executor", "address"): address,
     }, {"planner": ("VCAGE_LLM", {"provider": planner_provider, "base_url": planner_url,
                                   "model": planner_model, "timeout": planner_timeout,
-                                  "max_retries": planner_retries}),
+                                  "max_retries": planner_retries, "preflight": planner_preflight}),
         "critic": ("VCAGE_VLM", {"provider": critic_provider, "base_url": critic_url, "model": critic_model,
-                                 "timeout": critic_timeout, "max_retries": critic_retries})})
+                                 "timeout": critic_timeout, "max_retries": critic_retries,
+                                 "preflight": critic_preflight})})
     cfg = cfg.resolved()
     warn_if_oversubscribed(cfg.executor.name, cfg.executor.workers)
     if subtasks is not None or cfg.chain is not None:

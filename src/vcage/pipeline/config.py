@@ -27,7 +27,8 @@ from vcage.synthesis.scene_file import SynthesisRequest, SynthesizedScene
 
 SEED_LIMIT = 2**32  # seeds are unsigned 32-bit, as numpy's SeedSequence entropy
 # how a backend is reached, not what it answers: not compared when appending to a dataset
-TRANSPORT = ("api_key_env", "timeout", "max_retries", "backoff", "max_backoff", "breaker_failures")
+TRANSPORT = ("api_key_env", "timeout", "max_retries", "backoff", "max_backoff", "breaker_failures",
+             "preflight")
 
 
 @dataclass(frozen=True)
