@@ -206,8 +206,38 @@ def test_an_interrupted_append_is_undone_when_the_dataset_is_reopened(packed: Pa
     (packed / "meta/info.json").write_text(json.dumps(info | {"total_episodes": 4,
                                                               "total_frames": sum(LENGTHS[:4])}))
     assert pq.read_metadata(packed / "data/chunk-000/file-000.parquet").num_rows == sum(LENGTHS[:5])
-    assert verify(packed).ok  # checked in the backups: the committed bytes
+    report = verify(packed)  # checked in the backups: no episode is damaged, but a reader sees episode 4
+    assert not report.ok and report.damaged == () and "interrupted" in report.summary()
     with open_writer(packed) as w:
         assert w.num_episodes == 4
         assert {p: p.read_bytes() for p in committed} == committed
     assert verify(packed).ok and not list(packed.rglob(".*keep-*"))
+
+
+def test_repair_after_a_crash_puts_back_the_committed_bytes_and_says_so(packed: Path) -> None:
+    """Found on 2026-12-05: after a crash, verify said clean while a plain pyarrow reader saw the
+    uncommitted episode, and verify --repair said "nothing to repair" while it restored three files,
+    leaving a temporary file behind."""
+    committed = {p: p.read_bytes() for p in files(packed, "data") + files(packed, "videos")}
+    for path in committed:
+        shutil.copy(path, backup_path(path, 4))
+    with open_writer(packed) as w:  # a writer that appends for real, then a crash replayed by hand
+        add(w, 4)
+    for path, data in committed.items():
+        backup_path(path, 4).write_bytes(data)
+    info = json.loads((packed / "meta/info.json").read_text())
+    (packed / "meta/info.json").write_text(json.dumps(info | {"total_episodes": 4,
+                                                              "total_frames": sum(LENGTHS[:4])}))
+    scratch = packed / "data/chunk-000/.file-000.parquet.tmp-1-abcd"
+    scratch.write_bytes(b"partial")
+    data = packed / "data/chunk-000/file-000.parquet"
+    assert pq.read_table(data).num_rows == sum(LENGTHS[:5])  # what a plain reader sees
+    report = verify(packed)
+    assert not report.ok and report.damaged == ()
+    assert {p.path for p in report.problems} >= {str(p.relative_to(packed)) for p in committed}
+    result = repair(packed)
+    assert result.restored and result.after.ok and "nothing to repair" not in result.summary()
+    assert "put back the committed bytes" in result.summary() and result.kept == 4
+    assert {p: p.read_bytes() for p in committed} == committed and not scratch.exists()
+    assert pq.read_table(data).num_rows == sum(LENGTHS[:4])
+    assert not list(packed.rglob(".*keep-*")) and not list(packed.rglob(".*tmp-*"))

@@ -187,7 +187,7 @@ class DatasetWriter:
             raise DatasetError(f"{self.root} is not empty and holds no vcage dataset (no {layout.VCAGE_PATH} "
                                f"and {layout.INFO_PATH}); choose another --out directory or an empty one")
         settle_interrupted(self.root)  # an interrupted episode's replaced files: the committed bytes
-        report = check(self.root)
+        report = check(self.root).without_interrupted()  # what an interrupted write left is undone below
         if not report.ok:
             raise CorruptDatasetError(f"refusing to append to the damaged dataset {self.root}: "
                                       f"{report.brief()}; run `vcage verify {self.root} --repair` to "

@@ -13,7 +13,7 @@ import functools
 import os
 import time
 from collections import defaultdict
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -55,10 +55,11 @@ class RepairReport:
     removed: tuple[str, ...] = ()  # files deleted
     reasons: dict[int, list[str]] = field(default_factory=dict)  # dropped damaged episode -> its problems
     rebuilt: tuple[int, ...] = ()  # kept episodes whose lost metadata row was rebuilt from their files
+    restored: tuple[str, ...] = ()  # files an interrupted write had replaced, given their committed bytes
 
     @property
     def changed(self) -> bool:
-        return bool(self.rewritten or self.removed)
+        return bool(self.rewritten or self.removed or self.restored)
 
     def summary(self) -> str:
         if not self.changed:
@@ -73,6 +74,9 @@ class RepairReport:
         if self.rebuilt:
             lines.append(f"  rebuilt the metadata rows of {span(self.rebuilt[0], self.rebuilt[-1])} from "
                          "their files (image statistics from the decoded videos)")
+        if self.restored:
+            lines.append(f"  put back the committed bytes of {', '.join(self.restored)} (an interrupted "
+                         "write had replaced them)")
         if self.rewritten:
             lines.append(f"  rewrote {', '.join(self.rewritten)}")
         lines.append(f"  removed {len(self.removed)} files" if self.removed else "  removed no file")
@@ -105,11 +109,14 @@ def repair(root: str | Path) -> RepairReport:
         raise DatasetError(f"{root} is not a directory; give a dataset directory")
     fd = lock_dir(root)
     try:
-        settle_interrupted(root)  # an interrupted write's replaced files: the committed bytes
+        before = Scan(root, decode=True).run().report()  # as a reader finds it, interrupted writes included
+        restored = [p.relative_to(root).as_posix() for p in settle_interrupted(root)]  # the committed bytes
         scan = Scan(root, decode=True).run()
-        before = scan.report()
-        if before.ok:
-            return RepairReport(root, before, before, before.episodes)
+        if scan.report().ok:
+            leftovers = _remove_scratch(root)
+            after = verify(root) if restored or leftovers else before
+            return RepairReport(root, before, after, after.episodes, removed=tuple(leftovers),
+                                restored=tuple(restored))
         if scan.marker_damaged:
             raise CorruptDatasetError(f"cannot repair {root}: {layout.VCAGE_PATH} is damaged, and it holds "
                                       "the configuration the dataset was made with; restore it from a copy")
@@ -125,7 +132,8 @@ def repair(root: str | Path) -> RepairReport:
             scan = Scan(root, decode=True, rebuilt=rebuilt).run()
         found = scan.report()
         kept = found.first_damaged if found.first_damaged is not None else found.episodes
-        return _rewrite(scan, before, found, kept, tuple(i for i in sorted(rebuilt) if i < kept))
+        report = _rewrite(scan, before, found, kept, tuple(i for i in sorted(rebuilt) if i < kept))
+        return replace(report, restored=tuple(restored))
     finally:
         os.close(fd)
 
@@ -196,6 +204,16 @@ def _rewrite(scan: Scan, before: VerifyReport, found: VerifyReport, kept: int,
     return RepairReport(root, before, verify(root), kept, dropped,
                         tuple(i for i in dropped if i not in damaged), tuple(rewritten), tuple(removed),
                         {i: reasons[i] for i in dropped if i in damaged}, rebuilt)
+
+
+def _remove_scratch(root: Path) -> list[str]:
+    """Delete the temporary files an interrupted write left (hidden, marked ``.tmp-``); their names."""
+    out = []
+    for path in sorted(root.rglob(f".*{TMP_MARK}*")):
+        if path.is_file():
+            path.unlink()
+            out.append(path.relative_to(root).as_posix())
+    return out
 
 
 def _set_aside_bad_lines(root: Path) -> list[str]:

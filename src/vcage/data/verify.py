@@ -18,7 +18,7 @@ from __future__ import annotations
 import json
 import zipfile
 from collections import defaultdict
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -47,6 +47,7 @@ class Problem:
     episode: int | None
     what: str
     last: int | None = None
+    interrupted: bool = False  # what an interrupted write left: the next writer (or repair) undoes it
 
     @property
     def episodes(self) -> range:
@@ -78,6 +79,10 @@ class VerifyReport:
     @property
     def ok(self) -> bool:
         return not self.problems
+
+    def without_interrupted(self) -> VerifyReport:
+        """This report without what an interrupted write left (which the next writer undoes)."""
+        return replace(self, problems=tuple(p for p in self.problems if not p.interrupted))
 
     @property
     def damaged(self) -> tuple[int, ...]:
@@ -125,8 +130,10 @@ class VerifyReport:
         return "\n".join(lines)
 
     def raise_if_damaged(self) -> None:
-        """CorruptDatasetError naming the damage and the repair, unless the report is clean."""
-        if not self.ok:
+        """CorruptDatasetError naming the damage and the repair, unless the report is clean of all but
+        what an interrupted write left (vcage's readers read the committed bytes; a plain reader of
+        the files would not, which ``vcage verify`` reports)."""
+        if not self.without_interrupted().ok:
             raise CorruptDatasetError(f"{self.root} is damaged: {self.brief()}; run `vcage verify "
                                       f"{self.root} --repair` to drop the damaged episodes")
 
@@ -171,12 +178,13 @@ class Scan:
         self.row_files: dict[int, str] = {}  # episode -> the meta/episodes file that holds its row
         self.count_known = True  # False: info.json and an episodes file are both lost
 
-    def add(self, path: Path | str, episode: int | None, what: str, last: int | None = None) -> None:
+    def add(self, path: Path | str, episode: int | None, what: str, last: int | None = None,
+            interrupted: bool = False) -> None:
         try:
             rel = Path(path).relative_to(self.root).as_posix()
         except ValueError:
             rel = str(path)
-        self.problems.append(Problem(rel, episode, what, last))
+        self.problems.append(Problem(rel, episode, what, last, interrupted))
 
     def report(self) -> VerifyReport:
         lengths = [self.rows[i].get("length") for i in range(self.episodes) if i in self.rows]
@@ -262,10 +270,17 @@ class Scan:
                 self.add(path, None, _reason(exc))
                 unreadable.append(rel)
                 continue
+            beyond = 0
             for row in rows:
                 index = row.get("episode_index")
                 if isinstance(index, int) and (declared is None or 0 <= index < declared):
                     self.rows[index], self.row_files[index] = row, rel
+                elif isinstance(index, int) and declared is not None and index >= declared:
+                    beyond += 1
+            if beyond:  # LeRobot's reader lists every row: the interrupted episode would be read
+                self.add(path, None, f"holds the rows of {beyond} episode(s) whose write was interrupted "
+                                     "(never committed), which a reader of the file lists; `vcage verify "
+                                     "--repair` (or the next run) removes them", interrupted=True)
         for index, row in self.rebuilt.items():
             if index not in self.rows and (declared is None or index < declared):
                 self.rows[index] = row
@@ -371,7 +386,12 @@ class Scan:
         if not path.is_file():
             self._each(path, episodes, "missing")
             return None
-        return committed_version(path, self.episodes)
+        source = committed_version(path, self.episodes)
+        if source != path:  # checked in the backup; a plain reader of the file sees the episode
+            self.add(path, None, "holds an episode whose write was interrupted (never committed), which "
+                                 "a reader of the file sees; its committed bytes are kept beside it: "
+                                 "`vcage verify --repair` (or the next run) puts them back", interrupted=True)
+        return source
 
     def _each(self, path: Path, episodes: list[int], what: str) -> None:
         for i in episodes:
