@@ -56,25 +56,61 @@ def _from_goal(goal: Goal) -> tuple[list[SceneObject], list[SceneRelation]]:
 
 
 def _from_mentions(text: str) -> tuple[list[SceneObject], list[SceneRelation]]:
-    """One object per mention, except that "the X" after an X names that X again ("a mouse pad
-    behind a mouse, a cup right of the mouse pad" has one mouse pad)."""
+    """One object per mention (``count`` of them after a number: "three apples"), except that "the
+    X" after an X names that X again ("a mouse pad behind a mouse, a cup right of the mouse pad" has
+    one mouse pad). A mention the prompt negates ("no apple") or a relation of an object to itself
+    is refused: the scene would not be what was asked."""
     ws, mentions = lexicon_mentions(text)
     objects: list[SceneObject] = []
-    which: list[int] = []  # mention -> object
+    which: list[int] = []  # mention -> object (its first, where a count made several)
+    made: dict[int, range] = {}  # object -> the objects its mention made ("three apples": all three)
     for m in mentions:
+        _refuse_negated(ws, m)
         color = m.colours[0] if len(m.colours) == 1 else None
         again = _antecedent(ws, m, mentions[:len(which)], which, objects)
         if again is not None:
             which.append(again)
             continue
         base = f"{color}_{m.type}" if color else m.type
-        objects.append(SceneObject(name=_unique([o.name for o in objects], base), type=m.type, color=color,
-                                   scale=m.size or 1.0))
-        which.append(len(objects) - 1)
-    relations = [SceneRelation(kind=r.kind, a=objects[which[r.a]].name,  # type: ignore[arg-type]
-                               b=objects[which[r.b]].name)
-                 for r in explicit_relations(ws, mentions) if which[r.a] != which[r.b]]
+        which.append(len(objects))
+        made[len(objects)] = range(len(objects), len(objects) + _count(ws, m))
+        for _ in made[len(objects)]:
+            objects.append(SceneObject(name=_unique([o.name for o in objects], base), type=m.type,
+                                       color=color, scale=m.size or 1.0))
+    relations = []
+    for r in explicit_relations(ws, mentions):
+        if which[r.a] == which[r.b]:
+            raise PromptError(f"the prompt {bounded(text)} puts {objects[which[r.a]].name} {r.kind} itself; "
+                              "name two objects for a relation")
+        for a in made[which[r.a]]:  # each of "three apples on a plate" is on it
+            for b in made[which[r.b]]:
+                relations.append(SceneRelation(kind=r.kind, a=objects[a].name,  # type: ignore[arg-type]
+                                               b=objects[b].name))
     return objects, relations
+
+
+NEGATIONS = frozenset({"no", "not", "without", "except", "never", "nor", "none", "dont", "nothing"})
+NUMBERS = {"two": 2, "three": 3, "four": 4, "five": 5, "six": 6, "seven": 7, "eight": 8, "nine": 9,
+           "ten": 10, "eleven": 11, "twelve": 12}
+
+
+def _refuse_negated(ws: list[str], m: Mention) -> None:
+    """A mention with a negation among the two words before it ("no apple", "without a mug")."""
+    start = m.first if m.first >= 0 else m.start
+    said = [w for w in ws[max(0, start - 2):start] if w in NEGATIONS or w.endswith("n't")]
+    if said:
+        raise PromptError(f"the prompt says {' '.join(ws[max(0, start - 2):m.end])!r}: a scene is made of "
+                          "what it holds, so name only the objects it should hold")
+
+
+def _count(ws: list[str], m: Mention) -> int:
+    """How many objects the mention asks for: the number word or digits just before it, else one."""
+    start = m.first if m.first >= 0 else m.start
+    word = ws[start - 1] if start > 0 else ""
+    n = int(word) if word.isdigit() else NUMBERS.get(word, 1)
+    if n > MAX_OBJECTS:
+        raise PromptError(f"the prompt asks for {n} {m.noun}; a scene holds at most {MAX_OBJECTS} objects")
+    return max(n, 1)
 
 
 def _antecedent(ws: list[str], m: Mention, before: list[Mention], which: list[int],
@@ -116,7 +152,9 @@ def describe(prompt: str, retrieval: Retrieval | None = None) -> tuple[SceneDesc
     if not objects:
         raise PromptError(f"the prompt {bounded(text)} names no object of the catalog and matches no goal: "
                           "name objects (`vcage catalog` lists them) or a goal (`vcage tasks`)")
-    objects = objects[:MAX_OBJECTS]
+    if len(objects) > MAX_OBJECTS:
+        raise PromptError(f"the prompt {bounded(text)} names {len(objects)} objects; a scene holds at most "
+                          f"{MAX_OBJECTS} on the table: name fewer")
     relations += pairing(tuple(objects), relations)
     relations += row(tuple(objects), relations)
     data = {"prompt": text, "objects": [o.model_dump() for o in objects],
