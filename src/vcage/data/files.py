@@ -3,6 +3,7 @@ for the dataset writer and its repair."""
 
 from __future__ import annotations
 
+import errno
 import fcntl
 import json
 import os
@@ -118,6 +119,17 @@ def committed_version(path: Path, committed: int) -> Path:
     ``committed`` (which never committed) replaced it and left one, else ``path`` itself."""
     backup = backup_path(path, committed)
     return backup if backup.is_file() else path
+
+
+NO_SPACE = (errno.ENOSPC, errno.EDQUOT)
+
+
+def no_space(root: Path, exc: OSError, committed: int) -> DatasetError:
+    """The error of a write to the dataset at ``root`` that found its device full: what was kept and
+    how to continue."""
+    return DatasetError(f"no space left on the device of {root} ({exc.filename or exc}): the dataset holds "
+                        f"{committed} committed episodes, intact; free some space, then run the same command "
+                        "with --total to continue")
 
 
 def check_writable(path: Path, what: str = "--out") -> None:

@@ -35,6 +35,7 @@ from vcage.data import stats as st
 from vcage.data.card import dataset_card
 from vcage.data.files import (
     BACKUP_MARK,
+    NO_SPACE,
     TMP_MARK,
     atomic_write,
     diff,
@@ -42,6 +43,7 @@ from vcage.data.files import (
     episodes_table,
     keep_backup,
     lock_dir,
+    no_space,
     remove_empty_dirs,
     restore_backup,
     scratch,
@@ -428,13 +430,15 @@ class DatasetWriter:
             frames_after = self._total_frames + length
             write_text(self.root / layout.CARD_PATH, self._card(index + 1, frames_after, tasks))
             self._write_info(index + 1, frames_after, len(tasks))
-        except BaseException:
+        except BaseException as exc:
             if self._committed(index + 1):  # interrupted after the commit point: the episode is in
                 self._tasks, self._chunk_rows, self._stats = tasks, chunk_rows, stats
                 self._advance(position, video_start + length, length)
                 files.forget_backups()
             else:
                 self._rollback(files, meta_touched, index)
+            if isinstance(exc, OSError) and exc.errno in NO_SPACE:
+                raise no_space(self.root, exc, self._total_episodes) from exc
             raise
         self._tasks, self._chunk_rows, self._stats = tasks, chunk_rows, stats
         self._advance(position, video_start + length, length)

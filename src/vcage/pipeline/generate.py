@@ -22,6 +22,7 @@ from pathlib import Path
 from typing import Any
 
 from vcage.data import DatasetReader, DatasetWriter
+from vcage.data.files import NO_SPACE, no_space
 from vcage.data.layout import ATTEMPTS_LOG, RUNS_LOG
 from vcage.errors import ConfigError, VcageError
 from vcage.pipeline import attempt_log, critic_views
@@ -129,12 +130,22 @@ def generate(instruction: str, episodes: int, out: Path | str, cfg: GenerateConf
         except VcageError as exc:  # e.g. the critic's endpoint went away mid-run
             ended = f"failed: {exc}"
             raise
+        except OSError as exc:
+            if exc.errno not in NO_SPACE:
+                raise
+            ended = f"failed: {exc}"  # the attempt log could not take an episode's lines: reconciled later
+            raise no_space(out, exc, writer.num_episodes) from exc
         finally:  # the committed episodes are intact whatever ended the run: its entry says how it ended
             funnel.dataset_episodes = writer.num_episodes
             funnel.wall = time.perf_counter() - t0
             if writer.num_episodes:
-                attempt_log.append(out / RUNS_LOG, [{"instruction": plan.instruction, **funnel.to_dict(),
-                                                      "ended": ended, "software": software()}])
+                entry = {"instruction": plan.instruction, **funnel.to_dict(), "ended": ended,
+                         "software": software()}
+                try:
+                    attempt_log.append(out / RUNS_LOG, [entry])
+                except OSError:  # e.g. the disk that ended the run is still full: its error says so
+                    if ended == "complete":
+                        raise
     return funnel
 
 
