@@ -258,3 +258,45 @@ def test_no_random_corruption_of_an_episode_s_content_goes_unfound(pristine: Pat
     print(f"corruptions found by verify: {found}; harmless (nothing a reader sees changed): {harmless}")
     assert not missed, missed
     assert found >= 180, (found, harmless)  # most corruptions change something a reader sees
+
+
+# ------------------------------------------------------------------------------------------ schema
+
+def _marker(root: Path) -> dict:
+    return json.loads((root / "meta/vcage.json").read_text())
+
+
+def test_a_new_dataset_says_its_schema_and_a_row_that_lost_its_digests_is_found(ds: Path) -> None:
+    """Stripping the digests must not switch their checks off: a schema-2 dataset expects them."""
+    from vcage.data.schema import SCHEMA
+
+    assert _marker(ds)["schema"] == SCHEMA == 2
+    rows = pq.read_table(ds / EPISODES)
+    stripped = rows.set_column(rows.schema.get_field_index(digest.DATA), digest.DATA,
+                               pa.array([None, *rows.column(digest.DATA).to_pylist()[1:]], pa.string()))
+    pq.write_table(stripped, ds / EPISODES)
+    report = check(ds)
+    assert report.damaged == (0,) and "records no content digest vcage/sha256/data" in report.problems[0].what
+
+
+def test_a_dataset_of_the_schema_before_digests_is_read_verified_and_appended(ds: Path) -> None:
+    rows = pq.read_table(ds / EPISODES)
+    pq.write_table(rows.drop_columns([c for c in rows.column_names if c.startswith(digest.PREFIX)]),
+                   ds / EPISODES)
+    marker = {k: v for k, v in _marker(ds).items() if k != "schema"}
+    (ds / "meta/vcage.json").write_text(json.dumps(marker))
+    assert verify(ds).ok
+    with open_writer(ds) as w:
+        add(w, 9)
+    assert verify(ds).ok and "schema" not in _marker(ds)  # it keeps the schema it was made with
+    assert pq.read_table(ds / EPISODES).column(digest.DATA).to_pylist()[:4] == [None] * 4
+
+
+def test_a_dataset_of_a_newer_vcage_is_refused_not_misread(ds: Path) -> None:
+    from vcage.data import DatasetReader
+    from vcage.errors import DatasetError
+
+    (ds / "meta/vcage.json").write_text(json.dumps({**_marker(ds), "schema": 99}))
+    for read in (DatasetReader, open_writer, verify):
+        with pytest.raises(DatasetError, match="newer vcage .schema 99"):
+            read(ds)

@@ -177,6 +177,8 @@ def test_a_dataset_without_provenance_columns_is_read_and_appended(tmp_path: Pat
         add(w, extras={"seed": 2})
     old = pq.read_table(root / EPISODES)
     pq.write_table(old.drop_columns([c for c in old.column_names if c.startswith("vcage/")]), root / EPISODES)
+    marker = json.loads((root / "meta/vcage.json").read_text())  # schema 1: rows without digests
+    (root / "meta/vcage.json").write_text(json.dumps({k: v for k, v in marker.items() if k != "schema"}))
     reader = DatasetReader(root)
     assert reader.num_episodes == 2 and "vcage/seed" not in reader.episode_meta(1)
     assert verify(root).ok

@@ -61,6 +61,7 @@ def strip(root: Path, keys: tuple[str, ...] = (ENVIRONMENT, SUBTASK, ACTION_EE))
     (root / INFO_PATH).write_text(json.dumps(info))
     marker = json.loads((root / VCAGE_PATH).read_text())
     marker["info"]["features"] = info["features"]
+    marker.pop("schema", None)  # schema 1: rows without content digests
     (root / VCAGE_PATH).write_text(json.dumps(marker))
     stats = json.loads((root / STATS_PATH).read_text())
     (root / STATS_PATH).write_text(json.dumps({k: v for k, v in stats.items() if k not in keys}))

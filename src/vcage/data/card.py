@@ -88,8 +88,9 @@ def dataset_card(info: dict[str, Any], tasks: list[str]) -> str:
         "",
         "vcage's own files (LeRobot ignores them):",
         "",
-        f"- `{layout.VCAGE_PATH}`: the format marker and the configuration the dataset was made with; "
-        "appending needs the same configuration.",
+        f"- `{layout.VCAGE_PATH}`: the format marker, the schema of vcage's additions (2: every episode row "
+        "holds the SHA-256 content digests of its files, `vcage/sha256/*`) and the configuration the "
+        "dataset was made with; appending needs the same configuration.",
         f"- `{layout.ATTEMPTS_LOG}`: every attempt, accepted or not, with its stage, reason and "
         "oracle audit.",
         f"- `{layout.RUNS_LOG}`: one line per generation run: its funnel (attempts by stage, time) and the "

@@ -55,6 +55,7 @@ from vcage.data.files import (
     write_text,
 )
 from vcage.data.reader import DTYPES, STANDARD_COLUMNS, DatasetReader, Feature, load_json, read_parquet
+from vcage.data.schema import SCHEMA, schema_of
 from vcage.data.verify import check
 from vcage.errors import CorruptDatasetError, DatasetError
 
@@ -188,6 +189,7 @@ class DatasetWriter:
         if not (self.root / layout.VCAGE_PATH).is_file() or not (self.root / layout.INFO_PATH).is_file():
             raise DatasetError(f"{self.root} is not empty and holds no vcage dataset (no {layout.VCAGE_PATH} "
                                f"and {layout.INFO_PATH}); choose another --out directory or an empty one")
+        schema_of(load_json(self.root / layout.VCAGE_PATH), self.root)  # refuses a newer vcage's dataset
         settle_interrupted(self.root)  # an interrupted episode's replaced files: the committed bytes
         report = check(self.root).without_interrupted()  # what an interrupted write left is undone below
         if not report.ok:
@@ -325,8 +327,8 @@ class DatasetWriter:
         that :func:`vcage.data.repair.repair` can rebuild a damaged ``info.json``)."""
         static = {k: v for k, v in self._info(0, 0, 0).items()
                   if k not in ("total_episodes", "total_frames", "total_tasks", "splits")}
-        write_json(self.root / layout.VCAGE_PATH, {"format": "vcage/lerobot-v3", "config": self.config,
-                                                   "info": static})
+        write_json(self.root / layout.VCAGE_PATH, {"format": "vcage/lerobot-v3", "schema": SCHEMA,
+                                                   "config": self.config, "info": static})
 
     def _write_meta(self, tasks: list[str], chunk_rows: list[dict[str, Any]],
                     stats: dict[str, dict[str, np.ndarray]]) -> None:

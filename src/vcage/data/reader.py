@@ -26,6 +26,7 @@ from vcage.data.layout import (
     TASKS_PATH,
     VCAGE_PATH,
 )
+from vcage.data.schema import schema_of
 from vcage.data.video import decode_window
 from vcage.errors import CorruptDatasetError, DatasetError
 
@@ -152,6 +153,7 @@ class DatasetReader:
             marker = load_json(vcage)
             if not isinstance(marker, dict):
                 raise CorruptDatasetError(f"{vcage} does not hold a JSON object; the dataset is corrupt")
+            schema_of(marker, vcage)  # a newer vcage's dataset is refused, not misread
             self.config = marker.get("config")
         self._uncommitted = False  # meta rows beyond the commit point (left by a crash)
         self.tasks: list[str] = self._read_tasks() if self.num_episodes else []

@@ -29,6 +29,7 @@ import pyarrow.parquet as pq
 from vcage.data import digest, layout, video
 from vcage.data.files import committed_version
 from vcage.data.reader import NPZ_ERRORS, STANDARD_COLUMNS, load_json, load_npz, read_parquet
+from vcage.data.schema import expects_digests, schema_of
 from vcage.errors import CorruptDatasetError, DatasetError
 
 _INFO_KEYS = ("codebase_version", "fps", "total_episodes", "total_frames", "features", "data_path")
@@ -172,6 +173,7 @@ class Scan:
         self.static: dict[str, Any] | None = None  # info.json's layout part: from it or meta/vcage.json
         self.marker: dict[str, Any] | None = None  # meta/vcage.json
         self.marker_damaged = False
+        self.schema = 1  # meta/vcage.json's schema (:mod:`vcage.data.schema`)
         self.tasks: list[str] | None = None
         self.rows: dict[int, dict[str, Any]] = {}
         self.episodes = 0
@@ -208,6 +210,7 @@ class Scan:
         self._read_rows()
         self._read_tasks()
         self._check_rows()
+        self._check_digests_present()
         self._read_stats()
         self._check_data()
         self._check_videos()
@@ -229,6 +232,7 @@ class Scan:
             self.marker_damaged = True
             return
         self.marker = marker
+        self.schema = schema_of(marker, path)  # DatasetError for a newer vcage's dataset
 
     def _read_info(self, path: Path) -> None:
         try:
@@ -484,6 +488,22 @@ class Scan:
         """The content digest ``column`` that episode ``episode``'s row recorded, or None."""
         value = self.rows[episode].get(column) if episode in self.rows else None
         return value if isinstance(value, str) else None
+
+    def _check_digests_present(self) -> None:
+        """In a dataset whose schema records content digests, a row without them has lost them (a
+        row of an episode written without extras or states records none for those)."""
+        if not expects_digests(self.schema):
+            return
+        assert self.static is not None
+        cameras = [k for k, f in self.static["features"].items() if f.get("dtype") == "video"]
+        needed = [digest.DATA, *(digest.video_column(k) for k in cameras)]
+        for i in range(self.episodes):
+            if i not in self.rows:
+                continue
+            lost = [c for c in needed if self._recorded(i, c) is None]
+            if lost:
+                self.add(self.row_files[i], i, f"its row records no content digest {', '.join(lost)}, which "
+                                               f"every row of a schema-{self.schema} dataset holds")
 
     def _check_packets(self, path: Path, source: Path, episodes: list[int], key: str, fps: int) -> None:
         """The encoded packets in each episode's time window against the digest its row recorded."""
