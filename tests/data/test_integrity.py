@@ -341,3 +341,28 @@ def test_a_report_says_when_repair_cannot_help(ds: Path) -> None:
     report = verify(ds)
     assert not report.ok and not report.repairable and "cannot fix this" in report.summary()
     assert report.problems[0].path == INFO
+
+
+def test_repair_sets_aside_what_it_drops_and_deletes_nothing(ds: Path) -> None:
+    """Found on 2026-12-05: repair deleted the dropped episodes' files, intact ones included. They are
+    moved, byte for byte, to quarantine/<time>/ with a note of why; the dataset reads, verifies and
+    appends as before, and a later repair sets its own aside without touching the first."""
+    before = contents(ds)
+    truncate(ds / episode_files(2)[3])  # episode 2's states: episodes 2 and 3 are dropped
+    damaged = (ds / episode_files(2)[3]).read_bytes()
+    result = repair(ds)
+    assert result.kept == 2 and result.quarantine is not None and "nothing was deleted" in result.summary()
+    aside = ds / result.quarantine
+    for i in (2, 3):
+        for rel in episode_files(i):
+            kept_bytes = (aside / rel).read_bytes()
+            assert kept_bytes == (damaged if rel == episode_files(2)[3] else before[rel]), rel
+    note = (aside / "NOTE.md").read_text()
+    assert episode_files(2)[3] in note and "dropped episodes 2-3" in note
+    assert verify(ds).ok and DatasetReader(ds).num_episodes == 2
+    with open_writer(ds) as w:
+        assert add(w, 4, seed=7) == 2
+    truncate(ds / episode_files(2)[0])  # the appended episode's data
+    again = repair(ds)
+    assert again.quarantine not in (None, result.quarantine) and (aside / "NOTE.md").read_text() == note
+    assert verify(ds).ok

@@ -150,12 +150,16 @@ def test_damage_to_a_shared_file_costs_every_episode_in_it(packed: Path) -> None
 def test_repair_cuts_shared_files_after_the_last_kept_episode(packed: Path) -> None:
     states = packed / "extras/episode_000002_states.npz"
     states.write_bytes(states.read_bytes()[:20])
+    names = ["data/chunk-000/file-000.parquet", *(f"videos/{k}/chunk-000/file-000.mp4" for k in CAMS)]
+    shared = {rel: (packed / rel).read_bytes() for rel in names}
     before = DatasetReader(packed)
     kept = [(before.episode(i).frames["action"], before.video(i, CAMS[1])) for i in range(2)]
     result = repair(packed)
     assert (result.kept, result.dropped, result.healthy_dropped) == (2, (2, 3), (3,)) and result.after.ok
     assert "data/chunk-000/file-000.parquet" in result.rewritten
     assert pq.read_metadata(packed / "data/chunk-000/file-000.parquet").num_rows == sum(LENGTHS[:2])
+    assert result.quarantine is not None  # the shared files as they were, the dropped episodes' part too
+    assert {rel: (packed / result.quarantine / rel).read_bytes() for rel in shared} == shared
     for key in CAMS:
         frames, _ = video_mod.decode_video(packed / f"videos/{key}/chunk-000/file-000.mp4")
         assert len(frames) == sum(LENGTHS[:2])

@@ -11,6 +11,7 @@ from __future__ import annotations
 import contextlib
 import functools
 import os
+import shutil
 import time
 from collections import defaultdict
 from dataclasses import dataclass, field, replace
@@ -56,6 +57,7 @@ class RepairReport:
     reasons: dict[int, list[str]] = field(default_factory=dict)  # dropped damaged episode -> its problems
     rebuilt: tuple[int, ...] = ()  # kept episodes whose lost metadata row was rebuilt from their files
     restored: tuple[str, ...] = ()  # files an interrupted write had replaced, given their committed bytes
+    quarantine: str | None = None  # where what was removed or cut was set aside (relative to root)
 
     @property
     def changed(self) -> bool:
@@ -79,7 +81,11 @@ class RepairReport:
                          "write had replaced them)")
         if self.rewritten:
             lines.append(f"  rewrote {', '.join(self.rewritten)}")
-        lines.append(f"  removed {len(self.removed)} files" if self.removed else "  removed no file")
+        if self.quarantine:
+            lines.append(f"  set aside {len(self.removed)} files and the shared files as they were before "
+                         f"the cut in {self.quarantine}/ (NOTE.md there says why; nothing was deleted)")
+        else:
+            lines.append(f"  removed {len(self.removed)} files" if self.removed else "  removed no file")
         lines.append("  verified clean afterwards" if self.after.ok else
                      f"  still damaged afterwards: {self.after.brief()}")
         return "\n".join(lines)
@@ -149,6 +155,9 @@ def _rewrite(scan: Scan, before: VerifyReport, found: VerifyReport, kept: int,
             "splits": {"train": f"0:{kept}"}}
     keep = _files_of(scan, range(kept))
     doomed = _files_of(scan, range(kept, scan.episodes))
+    aside = Quarantine(root)
+    for rel in sorted(keep & doomed):  # the dropped episodes' part of a shared file is kept there
+        aside.copy(rel)
     rewritten = [*_cut_shared(scan, kept, sorted(keep & doomed)), *_set_aside_bad_lines(root),
                  layout.INFO_PATH]
     write_json(root / layout.INFO_PATH, info)  # the commit point: nothing beyond is read now
@@ -169,7 +178,7 @@ def _rewrite(scan: Scan, before: VerifyReport, found: VerifyReport, kept: int,
     else:
         for rel in (layout.STATS_PATH, layout.TASKS_PATH):
             if (root / rel).exists():
-                (root / rel).unlink()
+                aside.move(rel)
                 removed.append(rel)
     if scan.marker is not None:  # a vcage dataset: its card is vcage's (never replace another's README)
         write_text(root / layout.CARD_PATH, dataset_card(info, tasks))
@@ -177,11 +186,14 @@ def _rewrite(scan: Scan, before: VerifyReport, found: VerifyReport, kept: int,
     for path in sorted((root / "meta" / "episodes").glob("chunk-*/file-*.parquet")):
         rel = path.relative_to(root).as_posix()
         if rel not in by_file:
-            path.unlink()
+            if any(scan.row_files.get(i) == rel for i in range(kept, scan.episodes)):
+                aside.move(rel)  # rows of committed episodes the repair drops
+            else:
+                path.unlink()  # rows beyond the commit point: an interrupted write's
             removed.append(rel)
     last = rows[-1] if rows else None
     for path in sorted(root.rglob("*")):
-        if not path.is_file():
+        if not path.is_file() or path.is_relative_to(root / QUARANTINE):
             continue
         rel = path.relative_to(root).as_posix()
         index, position = layout.extras_episode(rel), layout.file_position(rel)
@@ -189,7 +201,10 @@ def _rewrite(scan: Scan, before: VerifyReport, found: VerifyReport, kept: int,
         stale = (index is not None and index >= kept) or rel in doomed or hidden or (
             position is not None and _beyond(position, last))
         if stale and rel not in keep:
-            path.unlink()
+            if rel in doomed or (index is not None and kept <= index < scan.episodes):
+                aside.move(rel)  # a file of a committed episode the repair drops
+            else:
+                path.unlink()  # a temporary file, a settled backup or an interrupted write's leftover
             removed.append(rel)
     for sub in ("data", "videos", "extras", "meta/episodes"):
         if (root / sub).is_dir():
@@ -201,9 +216,59 @@ def _rewrite(scan: Scan, before: VerifyReport, found: VerifyReport, kept: int,
     for p in found.problems:
         for i in p.episodes:
             reasons[i].append(f"{p.path}: {p.what}")
+    note = aside.note(found, kept, dropped)
     return RepairReport(root, before, verify(root), kept, dropped,
                         tuple(i for i in dropped if i not in damaged), tuple(rewritten), tuple(removed),
-                        {i: reasons[i] for i in dropped if i in damaged}, rebuilt)
+                        {i: reasons[i] for i in dropped if i in damaged}, rebuilt, quarantine=note)
+
+
+QUARANTINE = "quarantine"  # inside the dataset; LeRobot and vcage's readers never look there
+
+
+class Quarantine:
+    """Where a repair sets aside what it removes from the dataset or cuts out of a shared file:
+    ``quarantine/<time>/`` inside it, the files under their own paths, and ``NOTE.md`` saying why.
+    Created on first use; nothing is deleted."""
+
+    def __init__(self, root: Path) -> None:
+        self.root = root
+        self.dir: Path | None = None
+        self.entries: list[str] = []
+
+    def _target(self, rel: str) -> Path:
+        if self.dir is None:
+            stamp = time.strftime("%Y%m%d-%H%M%S")
+            base = self.root / QUARANTINE / stamp
+            k = 1
+            while base.exists():
+                k += 1
+                base = self.root / QUARANTINE / f"{stamp}-{k}"
+            self.dir = base
+        out = self.dir / rel
+        out.parent.mkdir(parents=True, exist_ok=True)
+        return out
+
+    def copy(self, rel: str) -> None:
+        """Keep the file at ``rel`` as it is now (before a repair cuts it)."""
+        if (self.root / rel).is_file():
+            shutil.copyfile(self.root / rel, self._target(rel))
+            self.entries.append(f"{rel}: as it was before the repair cut it")
+
+    def move(self, rel: str) -> None:
+        os.replace(self.root / rel, self._target(rel))
+        self.entries.append(f"{rel}: removed from the dataset")
+
+    def note(self, found: VerifyReport, kept: int, dropped: tuple[int, ...]) -> str | None:
+        """Write ``NOTE.md``; the folder relative to the dataset, or None where nothing was set aside."""
+        if self.dir is None:
+            return None
+        lines = [f"# Set aside by `vcage verify --repair` on {time.strftime('%Y-%m-%d %H:%M:%S')}", "",
+                 f"The dataset kept {span(0, kept - 1) if kept else 'no episode'}"
+                 + (f" and dropped {span(dropped[0], dropped[-1])}." if dropped else "."), "",
+                 "What verify found:", "", *(f"- {p}" for p in found.problems), "", "Files here:", "",
+                 *(f"- {e}" for e in self.entries), ""]
+        (self.dir / "NOTE.md").write_text("\n".join(lines))
+        return self.dir.relative_to(self.root).as_posix()
 
 
 def _remove_scratch(root: Path) -> list[str]:
