@@ -197,8 +197,9 @@ def test_a_backup_of_a_committed_episode_is_dropped_not_restored(packed: Path) -
     assert verify(packed).ok
 
 
-def test_an_interrupted_append_is_undone_when_the_dataset_is_reopened(packed: Path) -> None:
-    """A crash after episode 4 replaced the shared files, before its commit: the files go back."""
+def _crash_appending_episode_4(packed: Path) -> dict[Path, bytes]:
+    """A crash after episode 4 replaced the shared files (backups of their committed bytes beside
+    them), before its commit; the shared files' committed bytes."""
     committed = {p: p.read_bytes() for p in files(packed, "data") + files(packed, "videos")}
     for path in committed:
         shutil.copy(path, backup_path(path, 4))
@@ -209,6 +210,12 @@ def test_an_interrupted_append_is_undone_when_the_dataset_is_reopened(packed: Pa
     info = json.loads((packed / "meta/info.json").read_text())
     (packed / "meta/info.json").write_text(json.dumps(info | {"total_episodes": 4,
                                                               "total_frames": sum(LENGTHS[:4])}))
+    return committed
+
+
+def test_an_interrupted_append_is_undone_when_the_dataset_is_reopened(packed: Path) -> None:
+    """A crash after episode 4 replaced the shared files, before its commit: the files go back."""
+    committed = _crash_appending_episode_4(packed)
     assert pq.read_metadata(packed / "data/chunk-000/file-000.parquet").num_rows == sum(LENGTHS[:5])
     report = verify(packed)  # checked in the backups: no episode is damaged, but a reader sees episode 4
     assert not report.ok and report.damaged == () and "interrupted" in report.summary()
@@ -222,16 +229,7 @@ def test_repair_after_a_crash_puts_back_the_committed_bytes_and_says_so(packed: 
     """Found on 2026-12-05: after a crash, verify said clean while a plain pyarrow reader saw the
     uncommitted episode, and verify --repair said "nothing to repair" while it restored three files,
     leaving a temporary file behind."""
-    committed = {p: p.read_bytes() for p in files(packed, "data") + files(packed, "videos")}
-    for path in committed:
-        shutil.copy(path, backup_path(path, 4))
-    with open_writer(packed) as w:  # a writer that appends for real, then a crash replayed by hand
-        add(w, 4)
-    for path, data in committed.items():
-        backup_path(path, 4).write_bytes(data)
-    info = json.loads((packed / "meta/info.json").read_text())
-    (packed / "meta/info.json").write_text(json.dumps(info | {"total_episodes": 4,
-                                                              "total_frames": sum(LENGTHS[:4])}))
+    committed = _crash_appending_episode_4(packed)
     scratch = packed / "data/chunk-000/.file-000.parquet.tmp-1-abcd"
     scratch.write_bytes(b"partial")
     data = packed / "data/chunk-000/file-000.parquet"
