@@ -19,6 +19,7 @@ from typing import Any
 
 from vcage.data.files import atomic_write
 from vcage.data.layout import ATTEMPTS_LOG
+from vcage.data.reader import DatasetReader
 from vcage.errors import CorruptDatasetError
 from vcage.pipeline.stage import Stage
 
@@ -74,8 +75,6 @@ def committed_records(root: Path) -> list[Record]:
     """The attempt log of the dataset at ``root`` as its committed episodes hold it (what
     :func:`reconcile` would leave, without writing): what ``vcage audit`` and ``vcage report`` count,
     so that episodes a repair dropped are not counted. DatasetError if the log is corrupt."""
-    from vcage.data.reader import DatasetReader
-
     path = root / ATTEMPTS_LOG
     records = read(path, torn_tail=False)
     reader = DatasetReader(root, videos=False)
@@ -85,8 +84,6 @@ def committed_records(root: Path) -> list[Record]:
 def reconcile_dataset(root: Path) -> bool:
     """Reconcile the attempt log of the dataset at ``root`` with its committed episodes (after a
     repair dropped some); whether the log changed. Nothing is done where there is no log."""
-    from vcage.data.reader import DatasetReader
-
     path = root / ATTEMPTS_LOG
     if not path.is_file():
         return False
