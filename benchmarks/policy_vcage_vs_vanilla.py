@@ -618,13 +618,9 @@ def code_fingerprint() -> str:
     of the libraries (simulator, solvers, torch)."""
     from importlib.metadata import version
 
-    import vcage
-    from vcage.provenance import versions
+    from vcage.provenance import source_digest, versions
 
-    digest = hashlib.sha256()
-    root = Path(vcage.__file__).parent
-    for path in sorted(p for p in root.rglob("*") if p.is_file() and "__pycache__" not in p.parts):
-        digest.update(path.relative_to(root).as_posix().encode() + b"\0" + path.read_bytes())
+    digest = hashlib.sha256(source_digest().encode())
     digest.update(Path(__file__).read_bytes())
     digest.update(json.dumps(versions() | {"torch": version("torch")}, sort_keys=True).encode())
     return digest.hexdigest()[:16]

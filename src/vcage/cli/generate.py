@@ -320,14 +320,9 @@ def _advice(stages: dict[str, int]) -> str:
 
 def _committed(out: Path) -> int:
     """The episodes the dataset at ``out`` holds (its commit point), 0 where there is none."""
-    import json
+    from vcage.data.files import committed_episodes
 
-    from vcage.data.layout import INFO_PATH
-
-    try:
-        return int(json.loads((out / INFO_PATH).read_text())["total_episodes"])
-    except (OSError, ValueError, KeyError, TypeError):
-        return 0
+    return committed_episodes(out) or 0
 
 
 def _holds(out: Path) -> str:

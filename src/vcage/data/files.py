@@ -96,14 +96,20 @@ def settle_backups(root: Path, committed: int) -> list[Path]:
     return restored
 
 
+def committed_episodes(root: Path) -> int | None:
+    """The episodes ``meta/info.json`` commits (its ``total_episodes``), or None where it cannot be
+    read (the integrity checks report that)."""
+    try:
+        return int(json.loads((root / INFO_PATH).read_text())["total_episodes"])
+    except (OSError, ValueError, KeyError, TypeError):
+        return None
+
+
 def settle_interrupted(root: Path) -> list[Path]:
     """:func:`settle_backups` against the count ``meta/info.json`` commits; nothing when it cannot be
     read (the integrity checks report that)."""
-    try:
-        committed = int(json.loads((root / INFO_PATH).read_text())["total_episodes"])
-    except (OSError, ValueError, KeyError, TypeError):
-        return []
-    return settle_backups(root, committed)
+    committed = committed_episodes(root)
+    return [] if committed is None else settle_backups(root, committed)
 
 
 def restore_backup(backup: Path, original: Path) -> None:

@@ -38,6 +38,7 @@ from vcage.data.files import (
     NO_SPACE,
     TMP_MARK,
     atomic_write,
+    committed_episodes,
     diff,
     episode_row,
     episodes_table,
@@ -526,9 +527,8 @@ class DatasetWriter:
         return position, joined, digests
 
     def _committed(self, episodes: int) -> bool:
-        with contextlib.suppress(Exception):
-            return int(load_json(self.root / layout.INFO_PATH)["total_episodes"]) >= episodes
-        return False
+        committed = committed_episodes(self.root)
+        return committed is not None and committed >= episodes
 
     def _rollback(self, files: _EpisodeFiles, meta_touched: bool, index: int) -> None:
         """Undo a failed episode: put back the files it replaced, remove those it created, restore the
