@@ -3,7 +3,7 @@ content that leaves every file readable (a flipped byte inside a shared MP4, a v
 parquet file, an extras file edited) and a deleted per-episode file are found by ``check`` and
 ``verify``, named on the episodes they touch, and refused by the writer before it appends. A fuzz
 over random byte flips, truncations and deletions of every kind of file checks that no change of an
-episode's content goes unfound."""
+episode's content goes unfound, and that the repair keeps every episode whose content survived."""
 
 from __future__ import annotations
 
@@ -17,9 +17,11 @@ import pyarrow.compute as pc
 import pyarrow.parquet as pq
 import pytest
 
+from data.content import contents_by_episode
 from vcage.data import DatasetWriter, Feature, digest
 from vcage.data import video as video_mod
 from vcage.data.columns import add_features
+from vcage.data.repair import repair
 from vcage.data.verify import check, verify
 from vcage.errors import CorruptDatasetError
 
@@ -229,17 +231,56 @@ def _content(root: Path) -> dict[str, object] | None:
         return None
 
 
+def _intact(root: Path, pristine: Path) -> set[int]:
+    """The episodes whose content survived a corruption, judged from the files, not from the rows:
+    their own extras and states files byte-identical, their rows of the shared data file readable
+    and equal, and each camera's packets in their window byte-identical and decoding to the same
+    frames."""
+    rows = pq.read_table(pristine / EPISODES).to_pylist()
+    out = set(range(len(LENGTHS)))
+    for i in range(len(LENGTHS)):
+        for suffix in (".json", "_states.npz"):
+            rel = f"extras/episode_{i:06d}{suffix}"
+            if not (root / rel).is_file() or (root / rel).read_bytes() != (pristine / rel).read_bytes():
+                out.discard(i)
+    try:
+        table, original = pq.read_table(root / DATA), pq.read_table(pristine / DATA)
+        for i in range(len(LENGTHS)):
+            mine = pc.equal(table.column("episode_index"), i)
+            if table.filter(mine).to_pylist() != original.filter(pc.equal(original.column("episode_index"),
+                                                                            i)).to_pylist():
+                out.discard(i)
+    except Exception:  # noqa: BLE001 - an unreadable data file: no episode's rows survived
+        return set()
+    for key in CAMS:
+        for i, row in enumerate(rows):
+            window = (row[f"videos/{key}/from_timestamp"], row[f"videos/{key}/to_timestamp"], FPS)
+            try:  # the same encoded bytes (what the episode holds; a flip in the encoder's SEI
+                # changes them without changing a decoded pixel) that decode to the same frames
+                same = video_mod.packet_digests(root / video_path(key), [window[:2]], FPS) == \
+                    video_mod.packet_digests(pristine / video_path(key), [window[:2]], FPS) and \
+                    np.array_equal(video_mod.decode_window(root / video_path(key), *window),
+                                   video_mod.decode_window(pristine / video_path(key), *window))
+            except Exception:  # noqa: BLE001 - its frames cannot be read
+                same = False
+            if not same:
+                out.discard(i)
+    return out
+
+
 @pytest.mark.slow
 def test_no_random_corruption_of_an_episode_s_content_goes_unfound(pristine: Path, tmp_path: Path) -> None:
     """200 random corruptions (byte flips of 1-64 bytes, truncations, deletions) of the data file, each
     camera's shared video, the extras and states files and the episodes' metadata. Each one either
     is found by ``verify`` or leaves everything a reader sees byte-identical (a flip in a part of
-    an MP4 no frame is decoded from); ``check`` finds every one ``verify`` finds in per-episode
-    files and in the content digests."""
+    an MP4 no frame is decoded from). Each one found is repaired: the dataset verifies after it,
+    every episode it keeps holds exactly its original content, and no episode whose content
+    survived (:func:`_intact`) is dropped."""
     rng = np.random.default_rng(20261205)
     reference = _content(pristine)
     assert reference is not None
-    found = harmless = 0
+    by_episode = contents_by_episode(pristine)
+    found = harmless = kept = survived = 0
     missed: list[str] = []
     for trial in range(200):
         root = tmp_path / f"t{trial}"
@@ -250,12 +291,21 @@ def test_no_random_corruption_of_an_episode_s_content_goes_unfound(pristine: Pat
         report = verify(root)
         if not report.ok:
             found += 1
+            intact = _intact(root, pristine)
+            result = repair(root)
+            what = f"trial {trial}: {how} {path.relative_to(root)}"
+            assert result.after.ok, (what, result.summary())
+            held = [i for i in range(len(LENGTHS)) if i not in result.dropped]
+            assert contents_by_episode(root) == [by_episode[i] for i in held], what
+            assert intact <= set(held), (what, sorted(intact), held)
+            kept, survived = kept + len(held), survived + len(intact)
         elif _content(root) == reference:
             harmless += 1
         else:
             missed.append(f"{how} {path.relative_to(root)}")
         shutil.rmtree(root)
-    print(f"corruptions found by verify: {found}; harmless (nothing a reader sees changed): {harmless}")
+    print(f"corruptions found by verify: {found}; harmless (nothing a reader sees changed): {harmless}; "
+          f"episodes kept by the repairs: {kept} (of {found * len(LENGTHS)}; {survived} survived)")
     assert not missed, missed
     assert found >= 180, (found, harmless)  # most corruptions change something a reader sees
 

@@ -1,5 +1,6 @@
 """verify, check and repair on real files truncated for real: every damage is found and named, the
-repair drops exactly the damaged tail, and the writer and the export refuse a damaged dataset."""
+repair drops exactly the damaged episodes and keeps the others unchanged (renumbered), and the writer
+and the export refuse a damaged dataset."""
 
 from __future__ import annotations
 
@@ -13,6 +14,7 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 import pytest
 
+from data.content import contents_by_episode
 from vcage.data import DatasetReader, DatasetWriter, Feature
 from vcage.data.repair import repair
 from vcage.data.robomimic import export_robomimic
@@ -166,21 +168,25 @@ def test_a_time_window_that_disagrees_with_the_video_is_found_by_decoding(ds: Pa
     assert any("decodes to 3 frames" in p.what for p in report.problems)
 
 
-def test_repair_across_chunks_removes_the_dropped_chunks(tmp_path: Path) -> None:
+def test_repair_across_chunks_renumbers_the_episodes_after_the_damaged_one(tmp_path: Path) -> None:
     root = tmp_path / "ds"
     with DatasetWriter(root, fps=FPS, features=FEATURES, config=CONFIG, chunks_size=2,
                        data_files_size_in_mb=1e-6) as w:  # a data file per episode: 3 chunks
         for i in range(5):
-            w.add_episode({"observation.state": np.zeros((3, 4), np.float32),
+            w.add_episode({"observation.state": np.full((3, 4), i, np.float32),
                            "action": np.zeros((3, 3), np.float32)}, task="t", extras={"seed": i})
     truncate(root / "extras/episode_000001.json")
     result = repair(root)
-    assert (result.kept, result.dropped) == (1, (1, 2, 3, 4)) and result.after.ok
+    assert (result.kept, result.dropped, result.renumbered) == (4, (1,), {2: 1, 3: 2, 4: 3})
+    assert result.after.ok
     assert sorted(p.relative_to(root).as_posix() for p in (root / "meta/episodes").rglob("*.parquet")) == [
-        "meta/episodes/chunk-000/file-000.parquet"]
+        "meta/episodes/chunk-000/file-000.parquet", "meta/episodes/chunk-001/file-000.parquet"]
     assert sorted(p.relative_to(root).as_posix() for p in (root / "data").rglob("*.parquet")) == [
-        "data/chunk-000/file-000.parquet"]
-    assert pq.read_table(root / "meta/episodes/chunk-000/file-000.parquet").num_rows == 1
+        "data/chunk-000/file-000.parquet", "data/chunk-000/file-001.parquet",
+        "data/chunk-001/file-000.parquet", "data/chunk-001/file-001.parquet"]
+    reader = DatasetReader(root)
+    assert [reader.extras(i)["seed"] for i in range(4)] == [0, 2, 3, 4]
+    assert [reader.episode(i).frames["observation.state"][0, 0] for i in range(4)] == [0, 2, 3, 4]
 
 
 def test_leftovers_beyond_the_commit_point_are_not_damage(ds: Path) -> None:
@@ -190,32 +196,34 @@ def test_leftovers_beyond_the_commit_point_are_not_damage(ds: Path) -> None:
 
 
 @pytest.mark.parametrize("rel", PER_EPISODE, ids=[r.split("/")[-1] for r in PER_EPISODE])
-def test_repair_drops_exactly_the_damaged_tail_and_appends_again(ds: Path, rel: str) -> None:
-    before = contents(ds)
+def test_repair_drops_exactly_the_damaged_episode_keeps_the_rest_and_appends(ds: Path, rel: str) -> None:
+    """Found on 2026-12-05: a damaged episode cost every healthy episode after it. Now only the
+    damaged one goes; the one after it is renumbered with its content unchanged."""
+    before, files_before = contents_by_episode(ds), contents(ds)
     truncate(ds / rel)
     result = repair(ds)
-    assert (result.kept, result.dropped, result.healthy_dropped) == (2, (2, 3), (3,))
+    assert (result.kept, result.dropped, result.renumbered, result.healthy_dropped) == (3, (2,), {3: 2}, ())
     assert list(result.reasons) == [2] and rel in result.reasons[2][0]
     assert result.after.ok and verify(ds).ok
-    assert "dropped 2 (episodes 2-3)" in result.summary() and rel in result.summary()
+    assert "dropped 1 damaged (2)" in result.summary() and rel in result.summary()
+    assert "3 is now 2" in result.summary()
+    assert contents_by_episode(ds) == [before[0], before[1], before[3]]
     after = contents(ds)
-    for i in (0, 1):  # the kept episodes' files are untouched
-        assert all(after[f] == before[f] for f in episode_files(i))
-    for i in (2, 3):
-        assert not any(f in after for f in episode_files(i))
+    for i in (0, 1):  # the episodes before the damaged one keep their files byte for byte
+        assert all(after[f] == files_before[f] for f in episode_files(i))
     reader = DatasetReader(ds)
-    assert (reader.num_episodes, reader.total_frames) == (2, sum(LENGTHS[:2]))
+    assert (reader.num_episodes, reader.total_frames) == (3, sum(LENGTHS) - LENGTHS[2])
     with open_writer(ds) as w:
-        assert add(w, 4, seed=7) == 2
-    assert verify(ds).ok and DatasetReader(ds).episode(2).frames["index"][0] == sum(LENGTHS[:2])
+        assert add(w, 4, seed=7) == 3
+    assert verify(ds).ok and DatasetReader(ds).episode(3).frames["index"][0] == sum(LENGTHS) - LENGTHS[2]
 
 
-def test_repair_after_an_early_damage_says_what_the_healthy_episodes_cost(ds: Path) -> None:
+def test_verify_says_the_repair_keeps_the_healthy_episodes(ds: Path) -> None:
     truncate(ds / episode_files(1)[0])
-    assert "keeps episode 0 and drops episodes 1-3 (2 of them healthy)" in verify(ds).summary()
+    assert "drops the 1 damaged episode(s)" in verify(ds).summary()
+    assert "keeps the 3 intact one(s), renumbered" in verify(ds).summary()
     result = repair(ds)
-    assert (result.kept, result.dropped, result.healthy_dropped) == (1, (1, 2, 3), (2, 3))
-    assert "2 of them healthy" in result.summary()
+    assert (result.kept, result.dropped, result.renumbered) == (3, (1,), {2: 1, 3: 2})
 
 
 def test_repair_rebuilds_lost_episode_rows_from_the_files(ds: Path) -> None:
@@ -298,9 +306,9 @@ def test_export_of_a_repaired_dataset_works(ds: Path, tmp_path: Path) -> None:
     truncate(ds / VIDEO)
     repair(ds)
     summary = export_robomimic(ds, tmp_path / "demos.hdf5")
-    assert summary.demos == 2
+    assert summary.demos == 3
     with h5py.File(summary.path, "r") as f:
-        assert sorted(f["data"]) == ["demo_0", "demo_1"]
+        assert sorted(f["data"]) == ["demo_0", "demo_1", "demo_2"]
 
 
 def test_reader_errors_on_damaged_files_are_corruption(ds: Path) -> None:
@@ -323,10 +331,22 @@ def test_a_lost_info_json_is_named_and_rebuilt(ds: Path) -> None:
     assert repair(ds).after.ok and json.loads((ds / INFO).read_text()) == original
 
 
-def test_repair_of_a_damaged_first_episode_keeps_an_empty_dataset_that_appends(ds: Path) -> None:
+def test_repair_of_a_damaged_first_episode_keeps_the_others(ds: Path) -> None:
+    before = contents_by_episode(ds)
     truncate(ds / episode_files(0)[1])
     result = repair(ds)
-    assert (result.kept, result.dropped, result.healthy_dropped) == (0, (0, 1, 2, 3), (1, 2, 3))
+    assert (result.kept, result.dropped, result.renumbered) == (3, (0,), {1: 0, 2: 1, 3: 2})
+    assert contents_by_episode(ds) == before[1:] and result.after.ok
+    with open_writer(ds) as w:
+        assert add(w, 5, seed=4) == 3
+    assert verify(ds).ok
+
+
+def test_repair_of_every_episode_damaged_keeps_an_empty_dataset_that_appends(ds: Path) -> None:
+    for i in range(len(LENGTHS)):
+        truncate(ds / episode_files(i)[1])
+    result = repair(ds)
+    assert (result.kept, result.dropped) == (0, (0, 1, 2, 3))
     assert "kept no episode" in result.summary() and result.after.ok
     assert DatasetReader(ds).num_episodes == 0
     with open_writer(ds) as w:
@@ -348,21 +368,21 @@ def test_repair_sets_aside_what_it_drops_and_deletes_nothing(ds: Path) -> None:
     moved, byte for byte, to quarantine/<time>/ with a note of why; the dataset reads, verifies and
     appends as before, and a later repair sets its own aside without touching the first."""
     before = contents(ds)
-    truncate(ds / episode_files(2)[3])  # episode 2's states: episodes 2 and 3 are dropped
+    truncate(ds / episode_files(2)[3])  # episode 2's states: episode 2 is dropped, 3 renumbered
     damaged = (ds / episode_files(2)[3]).read_bytes()
     result = repair(ds)
-    assert result.kept == 2 and result.quarantine is not None and "nothing was deleted" in result.summary()
+    assert result.kept == 3 and result.quarantine is not None and "nothing was deleted" in result.summary()
     aside = ds / result.quarantine
-    for i in (2, 3):
+    for i in (2, 3):  # the files as they were, under their old names
         for rel in episode_files(i):
             kept_bytes = (aside / rel).read_bytes()
             assert kept_bytes == (damaged if rel == episode_files(2)[3] else before[rel]), rel
     note = (aside / "NOTE.md").read_text()
-    assert episode_files(2)[3] in note and "dropped episodes 2-3" in note
-    assert verify(ds).ok and DatasetReader(ds).num_episodes == 2
+    assert episode_files(2)[3] in note and "dropped episode 2" in note
+    assert verify(ds).ok and DatasetReader(ds).num_episodes == 3
     with open_writer(ds) as w:
-        assert add(w, 4, seed=7) == 2
-    truncate(ds / episode_files(2)[0])  # the appended episode's data
+        assert add(w, 4, seed=7) == 3
+    truncate(ds / episode_files(3)[0])  # the appended episode's data
     again = repair(ds)
     assert again.quarantine not in (None, result.quarantine) and (aside / "NOTE.md").read_text() == note
     assert verify(ds).ok

@@ -11,6 +11,7 @@ import numpy as np
 import pyarrow.parquet as pq
 import pytest
 
+from data.content import contents_by_episode
 from vcage.data import DatasetReader, DatasetWriter, Feature
 from vcage.data import video as video_mod
 from vcage.data.files import backup_path
@@ -147,29 +148,28 @@ def test_damage_to_a_shared_file_costs_every_episode_in_it(packed: Path) -> None
     assert result.kept == 0 and result.after.ok and not files(packed, "data")
 
 
-def test_repair_cuts_shared_files_after_the_last_kept_episode(packed: Path) -> None:
+def test_repair_keeps_every_intact_episode_of_shared_files(packed: Path) -> None:
+    """The damaged episode's part of each shared file goes; the episodes before and after it stay,
+    their packets copied (not re-encoded), the one after it renumbered."""
+    before = contents_by_episode(packed)
     states = packed / "extras/episode_000002_states.npz"
     states.write_bytes(states.read_bytes()[:20])
     names = ["data/chunk-000/file-000.parquet", *(f"videos/{k}/chunk-000/file-000.mp4" for k in CAMS)]
     shared = {rel: (packed / rel).read_bytes() for rel in names}
-    before = DatasetReader(packed)
-    kept = [(before.episode(i).frames["action"], before.video(i, CAMS[1])) for i in range(2)]
     result = repair(packed)
-    assert (result.kept, result.dropped, result.healthy_dropped) == (2, (2, 3), (3,)) and result.after.ok
+    assert (result.kept, result.dropped, result.renumbered) == (3, (2,), {3: 2}) and result.after.ok
     assert "data/chunk-000/file-000.parquet" in result.rewritten
-    assert pq.read_metadata(packed / "data/chunk-000/file-000.parquet").num_rows == sum(LENGTHS[:2])
-    assert result.quarantine is not None  # the shared files as they were, the dropped episodes' part too
+    kept_frames = LENGTHS[0] + LENGTHS[1] + LENGTHS[3]
+    assert pq.read_metadata(packed / "data/chunk-000/file-000.parquet").num_rows == kept_frames
+    assert result.quarantine is not None  # the shared files as they were, the dropped episode's part too
     assert {rel: (packed / result.quarantine / rel).read_bytes() for rel in shared} == shared
     for key in CAMS:
         frames, _ = video_mod.decode_video(packed / f"videos/{key}/chunk-000/file-000.mp4")
-        assert len(frames) == sum(LENGTHS[:2])
-    reader = DatasetReader(packed)
-    for i, (action, video) in enumerate(kept):
-        np.testing.assert_array_equal(reader.episode(i).frames["action"], action)
-        np.testing.assert_array_equal(reader.video(i, CAMS[1]), video)
-    with open_writer(packed) as w:  # appending joins the cut files again
-        assert add(w, 2) == 2
-    assert verify(packed).ok and rows(packed)[2]["data/file_index"] == 0
+        assert len(frames) == kept_frames
+    assert contents_by_episode(packed) == [before[0], before[1], before[3]]
+    with open_writer(packed) as w:  # appending joins the rewritten files again
+        assert add(w, 2) == 3
+    assert verify(packed).ok and rows(packed)[3]["data/file_index"] == 0
 
 
 def test_repair_rebuilds_lost_rows_of_episodes_in_shared_files(rolled: Path, tmp_path: Path) -> None:

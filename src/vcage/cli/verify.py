@@ -1,4 +1,5 @@
-"""``vcage verify``: check every file of a dataset against its metadata; ``--repair`` drops a damaged tail."""
+"""``vcage verify``: check every file of a dataset against its metadata; ``--repair`` drops the damaged
+episodes and keeps the intact ones."""
 
 from __future__ import annotations
 
@@ -16,17 +17,20 @@ from vcage.errors import CorruptDatasetError
 @app.command("verify")
 @cli_errors
 def verify_cmd(path: Path = typer.Argument(..., help="a dataset directory"),
-               repair: bool = typer.Option(False, "--repair", help="drop the episodes from the first damaged "
-                                           "one to the end and rewrite the metadata (says what it drops)")
+               repair: bool = typer.Option(False, "--repair", help="drop the damaged episodes, keep the "
+                                           "intact ones (renumbered), render videos again from stored states "
+                                           "where only they are damaged, rewrite the metadata; says what it "
+                                           "drops and sets it aside in quarantine/")
                ) -> None:
     """Check every episode's files (decoding the videos) and the metadata; fails if anything is damaged."""
     from vcage.data.layout import ATTEMPTS_LOG
     from vcage.data.repair import repair as repair_dataset
     from vcage.data.verify import verify
     from vcage.pipeline.attempt_log import reconcile_dataset
+    from vcage.pipeline.rerender import render_from_states
 
     if repair:
-        result = repair_dataset(path)
+        result = repair_dataset(path, render=render_from_states)
         print_problems(result.before)
         console.print(Text(result.summary()))
         if result.after.ok and reconcile_dataset(path):

@@ -35,6 +35,8 @@ RUNS_LOG = "meta/vcage_runs.jsonl"  # one line per generation run: its funnel (a
 # the attempt's sample index and attempt number in the attempt log (``episode``, ``attempt``)
 CRITIC_VIEW_PATH = "extras/critic_views/sample_{sample:06d}_attempt_{attempt:03d}.png"
 CARD_PATH = "README.md"  # the dataset card, rewritten at each commit
+REPAIR_STAGING = ".repair-staging"  # where `vcage verify --repair` builds what it puts in
+REPAIR_PLAN = REPAIR_STAGING + "/PLAN.json"  # written when that is complete: the repair is then due
 
 # per-episode provenance columns of meta/episodes (copied from the episode's extras when present)
 PROVENANCE = {"vcage/seed": "seed", "vcage/attempt": "attempt", "vcage/oracle_success": "oracle_success"}

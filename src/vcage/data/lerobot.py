@@ -267,11 +267,10 @@ class DatasetWriter:
         codecs = {ft["info"]["video.codec"] for ft in info["features"].values() if ft.get("dtype") == "video"}
         if not codecs:
             return ""
-        for encoder in video.available_encoders():
-            if video.codec_name(encoder) in codecs:
-                return encoder
-        raise DatasetError(f"{self.root} uses video codec {sorted(codecs)} but this PyAV build cannot "
-                           "encode it; append with the environment that created the dataset")
+        try:
+            return video.encoder_for(codecs)
+        except DatasetError as exc:
+            raise DatasetError(f"{self.root}: {exc}") from None
 
     def _remove_leftovers(self, rewrite_meta: bool) -> None:
         """Delete temporary files, backups, and episode files beyond the commit point (a crash's
@@ -507,7 +506,7 @@ class DatasetWriter:
         for key, tmp_video in encoded.items():
             path = self._file(key, position)
             if joined:
-                sources = [(path, self._file_frames), (tmp_video, len(checked[key]))]
+                sources = [(path, 0, self._file_frames), (tmp_video, 0, len(checked[key]))]
                 files.replace(path, committed, functools.partial(video.concat_videos, sources, fps=self.fps))
             else:
                 files.create(path, functools.partial(os.replace, tmp_video))

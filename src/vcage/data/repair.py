@@ -1,9 +1,12 @@
-"""Repair of a damaged dataset: drop every episode from the first damaged one to the end.
+"""Repair of a damaged dataset: drop the damaged episodes, keep every intact one.
 
-LeRobot's episode indices must stay contiguous, so the damaged tail goes; the metadata that a
-lost or damaged meta file held is rebuilt from the episodes' own files where it can be, and the
+In a vcage dataset the intact episodes after a damaged one are kept, renumbered so that LeRobot's
+episode indices stay contiguous, and an episode whose only damage is in its videos is rendered
+again from its stored states where that reproduces them exactly (:mod:`.compact`). In another
+LeRobot dataset the episodes from the first damaged one to the end are dropped. The metadata that
+a lost or damaged meta file held is rebuilt from the episodes' own files where it can be, and the
 result is checked again. Nothing is dropped silently: the report names every dropped episode and
-why, and how many healthy episodes the cut cost.
+why, and nothing is deleted: what the repair takes out goes to ``quarantine/<time>/``.
 """
 
 from __future__ import annotations
@@ -23,6 +26,7 @@ import pyarrow.compute as pc
 from vcage.data import digest, layout, video
 from vcage.data import stats as st
 from vcage.data.card import dataset_card
+from vcage.data.compact import Render, compact, finish, kept_tasks
 from vcage.data.files import (
     BACKUP_MARK,
     TMP_MARK,
@@ -58,21 +62,38 @@ class RepairReport:
     rebuilt: tuple[int, ...] = ()  # kept episodes whose lost metadata row was rebuilt from their files
     restored: tuple[str, ...] = ()  # files an interrupted write had replaced, given their committed bytes
     quarantine: str | None = None  # where what was removed or cut was set aside (relative to root)
+    renumbered: dict[int, int] = field(default_factory=dict)  # kept episode's old index -> new index
+    rerendered: tuple[int, ...] = ()  # kept after their videos were rendered again from their states
+    resumed: bool = False  # an interrupted repair was carried through first
+    compacted: bool = False  # the intact episodes were kept, renumbered (:mod:`.compact`)
 
     @property
     def changed(self) -> bool:
-        return bool(self.rewritten or self.removed or self.restored)
+        return bool(self.rewritten or self.removed or self.restored or self.resumed)
 
     def summary(self) -> str:
         if not self.changed:
             return f"{self.root}: nothing to repair; {self.kept} episodes verified"
         kept = span(0, self.kept - 1) if self.kept else "no episode"
         lines = [f"{self.root}: kept {kept}"]
+        if self.resumed:
+            lines.insert(0, f"{self.root}: carried an interrupted repair through")
+        if self.dropped and (self.renumbered or not self.healthy_dropped):
+            lines[-1] += f", dropped {len(self.dropped)} damaged ({_list(self.dropped)})"
+        elif self.dropped:
+            lines[-1] += (f", dropped {len(self.dropped)} ({span(self.dropped[0], self.dropped[-1])}), "
+                          f"{len(self.healthy_dropped)} of them healthy but after a damaged one")
         if self.dropped:
-            lines[0] += (f", dropped {len(self.dropped)} ({span(self.dropped[0], self.dropped[-1])}), "
-                         f"{len(self.healthy_dropped)} of them healthy but after a damaged one")
             for i in sorted(self.reasons):
                 lines += [f"  dropped episode {i}: {why}" for why in self.reasons[i]]
+        if self.renumbered:
+            moves = sorted(self.renumbered.items())
+            lines.append(f"  renumbered {len(moves)} intact episodes ({moves[0][0]} is now {moves[0][1]}"
+                         + (f", ..., {moves[-1][0]} is now {moves[-1][1]}" if len(moves) > 1 else "")
+                         + "); their content is unchanged")
+        if self.rerendered:
+            lines.append(f"  rendered the videos of {_list(self.rerendered)} again from their stored states "
+                         "(the encoded frames match those written)")
         if self.rebuilt:
             lines.append(f"  rebuilt the metadata rows of {span(self.rebuilt[0], self.rebuilt[-1])} from "
                          "their files (image statistics from the decoded videos)")
@@ -81,7 +102,10 @@ class RepairReport:
                          "write had replaced them)")
         if self.rewritten:
             lines.append(f"  rewrote {', '.join(self.rewritten)}")
-        if self.quarantine:
+        if self.quarantine and self.compacted:
+            lines.append(f"  set aside the {len(self.removed)} files it dropped or replaced, as they were, "
+                         f"in {self.quarantine}/ (NOTE.md there says why; nothing was deleted)")
+        elif self.quarantine:
             lines.append(f"  set aside {len(self.removed)} files and the shared files as they were before "
                          f"the cut in {self.quarantine}/ (NOTE.md there says why; nothing was deleted)")
         else:
@@ -91,8 +115,14 @@ class RepairReport:
         return "\n".join(lines)
 
 
-def repair(root: str | Path) -> RepairReport:
-    """Drop every episode from the first damaged one on, and rewrite the metadata; never silently.
+def repair(root: str | Path, render: Render | None = None) -> RepairReport:
+    """Drop the damaged episodes, and rewrite the metadata; never silently.
+
+    In a vcage dataset (``meta/vcage.json``) every intact episode is kept, renumbered, by
+    :func:`vcage.data.compact.compact` (crash-safe; an interrupted repair is carried through first),
+    and ``render`` (an episode's extras and states -> its frames), when given, renders again the
+    videos of episodes damaged in their videos alone. The rest of this docstring is the repair of
+    another LeRobot dataset, and of damaged metadata alone:
 
     Holds the writer's lock meanwhile (DatasetError if a writer is appending). Runs :func:`verify`
     (so it costs a decode of every video, twice: before and after). The episodes before the first
@@ -115,14 +145,15 @@ def repair(root: str | Path) -> RepairReport:
         raise DatasetError(f"{root} is not a directory; give a dataset directory")
     fd = lock_dir(root)
     try:
+        resumed = finish(root)
         before = Scan(root, decode=True).run().report()  # as a reader finds it, interrupted writes included
         restored = [p.relative_to(root).as_posix() for p in settle_interrupted(root)]  # the committed bytes
         scan = Scan(root, decode=True).run()
         if scan.report().ok:
             leftovers = _remove_scratch(root)
-            after = verify(root) if restored or leftovers else before
+            after = verify(root) if restored or leftovers or resumed else before
             return RepairReport(root, before, after, after.episodes, removed=tuple(leftovers),
-                                restored=tuple(restored))
+                                restored=tuple(restored), resumed=resumed)
         if scan.marker_damaged:
             raise CorruptDatasetError(f"cannot repair {root}: {layout.VCAGE_PATH} is damaged, and it holds "
                                       "the configuration the dataset was made with; restore it from a copy")
@@ -137,11 +168,30 @@ def repair(root: str | Path) -> RepairReport:
         if rebuilt:  # an episodes file was lost: check the episodes again with their rebuilt rows
             scan = Scan(root, decode=True, rebuilt=rebuilt).run()
         found = scan.report()
+        if found.damaged and scan.marker is not None:
+            return _compact(scan, before, found, render, tuple(restored), resumed)
         kept = found.first_damaged if found.first_damaged is not None else found.episodes
         report = _rewrite(scan, before, found, kept, tuple(i for i in sorted(rebuilt) if i < kept))
-        return replace(report, restored=tuple(restored))
+        return replace(report, restored=tuple(restored), resumed=resumed)
     finally:
         os.close(fd)
+
+
+def _compact(scan: Scan, before: VerifyReport, found: VerifyReport, render: Render | None,
+             restored: tuple[str, ...], resumed: bool) -> RepairReport:
+    root = scan.root
+    rewritten, scratch = _set_aside_bad_lines(root), _remove_scratch(root)
+    aside = Quarantine(root)
+    done = compact(scan, found, aside.folder(), render)
+    rebuilt = tuple(sorted(i for i in scan.rebuilt if i not in done.dropped))
+    return RepairReport(root, before, verify(root), done.kept, done.dropped, (), (*rewritten, *done.put),
+                        (*done.aside, *scratch), done.reasons, rebuilt, restored, aside.folder(),
+                        done.renumbered, done.rerendered, resumed, compacted=True)
+
+
+def _list(indices: tuple[int, ...]) -> str:
+    more = f" and {len(indices) - 8} more" if len(indices) > 8 else ""
+    return ", ".join(str(i) for i in indices[:8]) + more
 
 
 def _rewrite(scan: Scan, before: VerifyReport, found: VerifyReport, kept: int,
@@ -149,7 +199,7 @@ def _rewrite(scan: Scan, before: VerifyReport, found: VerifyReport, kept: int,
     root, static = scan.root, scan.static
     assert static is not None
     rows = [scan.rows[i] for i in range(kept)]
-    tasks = _kept_tasks(scan.tasks, rows)
+    tasks = kept_tasks(scan.tasks, rows)
     frames = sum(int(r["length"]) for r in rows)
     info = {**static, "total_episodes": kept, "total_frames": frames, "total_tasks": len(tasks),
             "splits": {"train": f"0:{kept}"}}
@@ -235,7 +285,8 @@ class Quarantine:
         self.dir: Path | None = None
         self.entries: list[str] = []
 
-    def _target(self, rel: str) -> Path:
+    def folder(self) -> str:
+        """The folder (relative to the dataset) this repair sets aside into; chosen on first call."""
         if self.dir is None:
             stamp = time.strftime("%Y%m%d-%H%M%S")
             base = self.root / QUARANTINE / stamp
@@ -244,7 +295,10 @@ class Quarantine:
                 k += 1
                 base = self.root / QUARANTINE / f"{stamp}-{k}"
             self.dir = base
-        out = self.dir / rel
+        return self.dir.relative_to(self.root).as_posix()
+
+    def _target(self, rel: str) -> Path:
+        out = self.root / self.folder() / rel
         out.parent.mkdir(parents=True, exist_ok=True)
         return out
 
@@ -329,7 +383,7 @@ def _cut_shared(scan: Scan, kept: int, shared: list[str]) -> list[str]:
         elif key in cameras:
             frames = sum(int(scan.rows[i]["length"]) for i in range(kept)
                          if layout.row_position(scan.rows[i], key) == position)
-            atomic_write(path, functools.partial(video.concat_videos, [(path, frames)], fps=fps))
+            atomic_write(path, functools.partial(video.concat_videos, [(path, 0, frames)], fps=fps))
         out.append(rel)
     return out
 
@@ -405,16 +459,6 @@ def _rebuild_row(root: Path, static: dict[str, Any], tasks: list[str], index: in
     return episode_row(index, tasks[task_index], length, start, position=position, video_start=video_start,
                        chunks_size=chunks_size, fps=fps, cameras=cameras, stats=stats,
                        extras=extras if isinstance(extras, dict) else None, digests=digests)
-
-
-def _kept_tasks(tasks: list[str] | None, rows: list[dict[str, Any]]) -> list[str]:
-    """The task list for the kept rows: a prefix of the existing list up to the last task they use
-    (task indices in the data files stay valid), or, when ``tasks.parquet`` is lost, the tasks in
-    order of first appearance (the order the writer gives them)."""
-    used = [str((r.get("tasks") or [""])[0]) for r in rows]
-    if tasks is not None and all(t in tasks for t in used):
-        return tasks[:1 + max((tasks.index(t) for t in used), default=-1)]
-    return list(dict.fromkeys(used))
 
 
 def _files_of(scan: Scan, episodes: range) -> set[str]:

@@ -76,6 +76,7 @@ class VerifyReport:
     decoded: bool  # videos fully decoded (verify) or only their container read (check)
     problems: tuple[Problem, ...] = ()
     repairable: bool = True  # False: :func:`repair` refuses (lost info.json without a copy, lost config)
+    keeps_intact: bool = False  # a vcage dataset: the repair keeps every intact episode, renumbered
 
     @property
     def ok(self) -> bool:
@@ -124,6 +125,11 @@ class VerifyReport:
                          "where it can, then drops the episodes from the first damaged one on")
         elif first is None:
             lines.append("no episode is lost; `vcage verify --repair` rewrites the metadata")
+        elif self.keeps_intact:
+            intact = self.episodes - len(self.damaged)
+            lines.append(f"`vcage verify --repair` drops the {len(self.damaged)} damaged episode(s), unless "
+                         "their videos alone are damaged and render again from their stored states, and "
+                         + (f"keeps the {intact} intact one(s), renumbered" if intact else "keeps no other"))
         else:
             keeps = f"keeps {span(0, first - 1)} and drops" if first else "drops every episode:"
             lines.append(f"`vcage verify --repair` {keeps} {span(first, self.episodes - 1)} "
@@ -193,7 +199,8 @@ class Scan:
         frames = sum(n for n in lengths if isinstance(n, int))
         order = sorted(self.problems, key=lambda p: (p.episode is not None, p.episode or 0, p.path))
         repairable = self.static is not None and self.count_known and not self.marker_damaged
-        return VerifyReport(self.root, self.episodes, frames, self.decode, tuple(order), repairable)
+        return VerifyReport(self.root, self.episodes, frames, self.decode, tuple(order), repairable,
+                            keeps_intact=self.marker is not None)
 
     # metadata -------------------------------------------------------------------------------------
 
@@ -203,6 +210,9 @@ class Scan:
         info_path, marker_path = self.root / layout.INFO_PATH, self.root / layout.VCAGE_PATH
         if not info_path.exists() and not marker_path.exists():
             raise DatasetError(f"{info_path} is missing; {self.root} is not a dataset")
+        if (self.root / layout.REPAIR_PLAN).is_file():
+            self.add(layout.REPAIR_PLAN, None, "a repair was interrupted after it was planned; `vcage verify "
+                                               "--repair` carries it through")
         self._read_marker(marker_path)
         self._read_info(info_path)
         if self.static is None:
@@ -532,8 +542,8 @@ class Scan:
     def _check_decoded(self, path: Path, source: Path, episodes: list[int], key: str, fps: int) -> None:
         try:
             times = video.decode_times(source)
-        except CorruptDatasetError as exc:
-            self._each(path, episodes, _reason(exc))
+        except CorruptDatasetError as exc:  # damaged packets: which episodes' windows still decode?
+            self._check_windows(path, source, episodes, key, fps, _reason(exc))
             return
         half = 0.5 / fps
         for i in episodes:
@@ -547,6 +557,23 @@ class Scan:
             decoded = int(((times >= start - half) & (times < stop - half)).sum())
             if decoded != length:
                 self.add(path, i, f"decodes to {decoded} frames in the episode's window, expected {length}")
+
+    def _check_windows(self, path: Path, source: Path, episodes: list[int], key: str, fps: int,
+                       why: str) -> None:
+        """Decode each episode's window alone (from the key frame it starts at), where the file as a
+        whole does not decode: damaged packets cost the episodes they lie in, not every episode of
+        the file."""
+        for i in episodes:
+            row, length = self.rows[i], int(self.rows[i]["length"])
+            try:
+                frames = video.decode_window(source, float(row[f"videos/{key}/from_timestamp"]),
+                                             float(row[f"videos/{key}/to_timestamp"]), fps)
+            except (CorruptDatasetError, KeyError, TypeError, ValueError):
+                self.add(path, i, why)
+                continue
+            if len(frames) != length:
+                self.add(path, i, f"decodes to {len(frames)} frames in the episode's window, expected "
+                                  f"{length}")
 
     def _check_logs(self) -> None:
         """vcage's JSON-lines logs: every line but the last is JSON (a crash tears only the last one,

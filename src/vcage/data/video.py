@@ -72,6 +72,16 @@ def codec_name(encoder: str) -> str:
     return str(av.Codec(encoder, "w").canonical_name)
 
 
+def encoder_for(codecs: set[str]) -> str:
+    """An available encoder whose output is one of ``codecs`` (a dataset's recorded codec);
+    DatasetError where this PyAV build has none."""
+    for encoder in available_encoders():
+        if codec_name(encoder) in codecs:
+            return encoder
+    raise DatasetError(f"the dataset uses video codec {sorted(codecs)} but this PyAV build cannot encode it; "
+                       "use the environment that created the dataset")
+
+
 def check_frame_size(height: int, width: int, key: str = "video") -> None:
     """yuv420p needs even, positive sizes; raise DatasetError otherwise."""
     if height <= 0 or width <= 0 or height % 2 or width % 2:
@@ -232,15 +242,17 @@ def packet_digests(path: Path, windows: list[tuple[float, float]], fps: int) -> 
     return [d.hexdigest() for d in digests]
 
 
-def concat_videos(sources: list[tuple[Path, int]], out: Path, fps: int) -> None:
-    """Write the first ``n`` frames of each ``(path, n)`` source, one after the other, to ``out``.
+def concat_videos(sources: list[tuple[Path, int, int]], out: Path, fps: int) -> None:
+    """Write the frames ``first .. first + n - 1`` of each ``(path, first, n)`` source, one after the
+    other, to ``out``.
 
-    Stream copy (no re-encoding, so decoded frames stay bit-identical): packets are copied with
-    their timestamps shifted by the frames before them, so source k's frame i gets timestamp
-    ``(frames of the sources before k + i) / fps``. Each source must start with a key frame and
-    its frames must not reference frames beyond the cut (true of the episodes vcage encodes one at
-    a time); the sources must share codec, size and time base. CorruptDatasetError names a source
-    that cannot be read or has fewer than ``n`` frames; DatasetError one that does not match.
+    Stream copy (no re-encoding, so decoded frames stay bit-identical and every packet's bytes, and
+    so its content digest, are kept): packets are copied with their timestamps shifted, so that
+    source k's frame ``first + i`` gets timestamp ``(frames of the sources before k + i) / fps``.
+    Each clip must start with a key frame and its frames must not reference frames outside it
+    (true of the episodes vcage encodes one at a time); the sources must share codec, size and
+    time base. CorruptDatasetError names a source that cannot be read or has fewer frames than
+    asked; DatasetError one that does not match, or a clip that does not start at a key frame.
     """
     import av
     frame_seconds = Fraction(1, fps)
@@ -248,7 +260,7 @@ def concat_videos(sources: list[tuple[Path, int]], out: Path, fps: int) -> None:
         target: av.VideoStream | None = None
         template: tuple[object, ...] | None = None
         offset = Fraction(0)  # seconds before the current source
-        for path, keep in sources:
+        for path, first, keep in sources:
             copied = 0
             try:
                 with av.open(str(path)) as source:
@@ -262,13 +274,18 @@ def concat_videos(sources: list[tuple[Path, int]], out: Path, fps: int) -> None:
                                            "base or encoder settings differ")
                     tb = stream.time_base
                     assert tb is not None
-                    shift = int(offset / tb)
-                    cut = Fraction(keep) * frame_seconds - frame_seconds / 2  # frames before it are kept
+                    begin = Fraction(first) * frame_seconds
+                    shift = int((offset - begin) / tb)
+                    low = begin - frame_seconds / 2  # the clip's frames lie in [low, high)
+                    high = begin + Fraction(keep) * frame_seconds - frame_seconds / 2
                     for packet in source.demux(stream):
                         if packet.dts is None or packet.pts is None:
                             continue  # the demuxer's empty flush packet
-                        if packet.pts * tb >= cut:
+                        if not low <= packet.pts * tb < high:
                             continue
+                        if not copied and not packet.is_keyframe:
+                            raise DatasetError(f"frame {first} of {path} is not a key frame; a clip cannot "
+                                               "start there without re-encoding")
                         packet.pts += shift
                         packet.dts += shift
                         packet.stream = target
