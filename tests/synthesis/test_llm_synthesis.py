@@ -13,6 +13,7 @@ import pytest
 from backends.fake_openai import FakeOpenAI, Status
 from vcage.backends import BackendConfig, ChatBackend, connect
 from vcage.errors import BackendUnavailableError
+from vcage.synthesis.asked import read_prompt
 from vcage.synthesis.driver import DirectorySink, SynthesisConfig, shortlist, synthesize, unknown_phrases
 from vcage.synthesis.errors import PromptError, SceneDescriptionError
 from vcage.synthesis.llm_chooser import Choice, LLMChooser
@@ -122,3 +123,63 @@ def test_a_run_with_no_suitable_object_ends_typed(server: FakeOpenAI, llm: ChatB
         synthesize("a laptop next to a mug", SynthesisConfig(), DirectorySink(tmp_path), llm=llm)
     funnel = json.loads((tmp_path / "funnel.json").read_text())
     assert [(f["stage"], f["status"]) for f in funnel] == [("retrieval", "no_match")]
+
+
+# -- the LLM answers to what the prompt asks for (issue 52: synthesis never changes the request) --------
+
+
+def test_what_a_prompt_asks_for() -> None:
+    asked = read_prompt("three apples in a bowl, a red mug and no plate")
+    assert [(o.type, o.color, o.count) for o in asked.objects] == [("apple", None, 3), ("bowl", None, 1),
+                                                                   ("mug", "red", 1)]
+    assert [asked.relation_text(r) for r in asked.relations] == ["inside(apple, bowl)"]
+    assert [(o.type, o.phrase) for o in asked.negated] == [("plate", "no plate")]
+
+
+def test_a_choice_that_drops_a_count_or_takes_a_negated_object_is_sent_back(server: FakeOpenAI,
+                                                                          llm: ChatBackend) -> None:
+    asked = read_prompt("two mugs and a bowl but no plate")
+    server.script('{"objects": [{"type": "mug"}, {"type": "bowl"}, {"type": "plate"}], "no_match": null}',
+                  '{"objects": [{"type": "mug", "count": 2}, {"type": "bowl"}], "no_match": null}')
+    choice = LLMChooser(llm).choose("two mugs and a bowl but no plate", ("plate", "cup"), asked)
+    assert choice.objects == (("mug", 2), ("bowl", 1)) and choice.replies == 2
+    assert choice.shortlist[:2] == ("mug", "bowl")  # the named types are candidates, first
+    repair = server.requests[1]["messages"][-1]["content"]
+    assert "asks for 2 x mug; the choice has 1" in repair and "'no plate'; the choice has plate" in repair
+    with pytest.raises(PromptError, match="asks for 6 x apple; the LLM chooser takes at most 4"):
+        LLMChooser(llm).choose("six apples", SHORT, read_prompt("six apples"))
+
+
+def test_a_description_that_drops_a_relation_or_holds_a_negated_object_is_refused(
+        server: FakeOpenAI, llm: ChatBackend) -> None:
+    prompt = "a mug left of a plate, and no red apple"
+    choice = Choice((("mug", 1), ("plate", 1), ("apple", 1)), None, ("mug", "plate", "apple"))
+    red = {"name": "apple", "type": "apple", "color": "red"}
+    bad = json.loads(scene([("mug", "mug"), ("plate", "plate"), ("apple", "apple")],
+                           [("right_of", "mug", "plate")]))
+    bad["objects"][2] = red
+    server.script(*[json.dumps(bad)] * 3)
+    with pytest.raises(SceneDescriptionError, match=r"asks for left_of\(mug, plate\).*relates 0 so"):
+        LLMDescriber(llm).describe(prompt, choice, read_prompt(prompt))
+    system = server.requests[0]["messages"][0]["content"]
+    assert "The prompt asks for: 1 x mug; 1 x plate; left_of(mug, plate); no red apple." in system
+    assert "'no red apple'; the description has apple" in server.requests[1]["messages"][-1]["content"]
+    good = json.loads(scene([("mug", "mug"), ("plate", "plate"), ("apple", "apple")],
+                            [("right_of", "plate", "mug")]))  # the same relation, said the other way
+    server.script(json.dumps(good))
+    desc, _ = LLMDescriber(llm).describe(prompt, choice, read_prompt(prompt))  # a green apple is no red one
+    assert [str(r) for r in desc.relations] == ["right_of(plate, mug)"]
+
+
+def test_a_run_whose_llm_drops_a_count_ends_typed(server: FakeOpenAI, llm: ChatBackend,
+                                                  tmp_path: Path) -> None:
+    reply = json.loads(scene([("a1", "apple"), ("a2", "apple"), ("plate", "plate")],
+                             [("on", "a1", "plate"), ("on", "a2", "plate")]))
+    reply["objects"][0]["color"], reply["objects"][1]["color"] = "red", "green"
+    server.script('{"objects": [{"type": "apple", "count": 2}, {"type": "plate"}], "no_match": null}',
+                  *[json.dumps(reply)] * 3)
+    with pytest.raises(SceneDescriptionError, match=r"asks for 2 x red apple \('two red apples'\); the "
+                                                    "description has 1"):
+        synthesize("two red apples on a plate", SynthesisConfig(), DirectorySink(tmp_path), llm=llm)
+    funnel = json.loads((tmp_path / "funnel.json").read_text())
+    assert [(f["stage"], f["status"]) for f in funnel] == [("retrieval", "ok"), ("description", "rejected")]

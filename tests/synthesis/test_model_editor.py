@@ -226,4 +226,5 @@ def test_the_cli_with_an_llm_and_an_openai_image_endpoint(tmp_path: Path,
 def chat_replies() -> list[str]:
     return ['{"objects": [{"type": "mug"}, {"type": "plate"}], "no_match": null}',
             json.dumps({"objects": [{"name": "mug", "type": "mug"}, {"name": "plate", "type": "plate"}],
-                        "relations": [], "text": "A mug and a plate."})]
+                        "relations": [{"kind": "near", "a": "mug", "b": "plate"}],
+                        "text": "A mug near a plate."})]

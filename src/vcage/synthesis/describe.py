@@ -13,12 +13,12 @@ from dataclasses import dataclass
 
 from vcage.planning.goals import GOALS, Goal
 from vcage.planning.language import bounded
-from vcage.planning.lexicon import Mention
 from vcage.planning.offline import OfflinePlanner
+from vcage.synthesis.asked import read_prompt
 from vcage.synthesis.description import MAX_OBJECTS, SceneDescription, SceneObject, SceneRelation
 from vcage.synthesis.description import parse_description as _parse
 from vcage.synthesis.errors import PromptError, SceneDescriptionError
-from vcage.synthesis.prompt import check_prompt, explicit_relations, lexicon_mentions
+from vcage.synthesis.prompt import check_prompt
 from vcage.synthesis.retrieval import Retrieval
 from vcage.synthesis.templates import image_text, pairing, row
 
@@ -56,71 +56,24 @@ def _from_goal(goal: Goal) -> tuple[list[SceneObject], list[SceneRelation]]:
 
 
 def _from_mentions(text: str) -> tuple[list[SceneObject], list[SceneRelation]]:
-    """One object per mention (``count`` of them after a number: "three apples"), except that "the
-    X" after an X names that X again ("a mouse pad behind a mouse, a cup right of the mouse pad" has
-    one mouse pad). A mention the prompt negates ("no apple") or a relation of an object to itself
-    is refused: the scene would not be what was asked."""
-    ws, mentions = lexicon_mentions(text)
+    """The objects and relations the prompt asks for (:func:`~vcage.synthesis.asked.read_prompt`),
+    named; a negated object ("no apple") is refused: the scene is made of what it holds."""
+    asked = read_prompt(text)
+    if asked.negated:
+        raise PromptError(f"the prompt says {asked.negated[0].phrase!r}: a scene is made of what it holds, "
+                          "so name only the objects it should hold")
     objects: list[SceneObject] = []
-    which: list[int] = []  # mention -> object (its first, where a count made several)
-    made: dict[int, range] = {}  # object -> the objects its mention made ("three apples": all three)
-    for m in mentions:
-        _refuse_negated(ws, m)
-        color = m.colours[0] if len(m.colours) == 1 else None
-        again = _antecedent(ws, m, mentions[:len(which)], which, objects)
-        if again is not None:
-            which.append(again)
-            continue
-        base = f"{color}_{m.type}" if color else m.type
-        which.append(len(objects))
-        made[len(objects)] = range(len(objects), len(objects) + _count(ws, m))
-        for _ in made[len(objects)]:
-            objects.append(SceneObject(name=_unique([o.name for o in objects], base), type=m.type,
-                                       color=color, scale=m.size or 1.0))
-    relations = []
-    for r in explicit_relations(ws, mentions):
-        if which[r.a] == which[r.b]:
-            raise PromptError(f"the prompt {bounded(text)} puts {objects[which[r.a]].name} {r.kind} itself; "
-                              "name two objects for a relation")
-        for a in made[which[r.a]]:  # each of "three apples on a plate" is on it
-            for b in made[which[r.b]]:
-                relations.append(SceneRelation(kind=r.kind, a=objects[a].name,  # type: ignore[arg-type]
-                                               b=objects[b].name))
+    made: list[range] = []  # group -> its objects ("three apples": all three)
+    for g in asked.objects:
+        base = f"{g.color}_{g.type}" if g.color else g.type
+        start = len(objects)
+        for _ in range(g.count):
+            objects.append(SceneObject(name=_unique([o.name for o in objects], base), type=g.type,
+                                       color=g.color, scale=g.scale))
+        made.append(range(start, len(objects)))
+    relations = [SceneRelation(kind=r.kind, a=objects[a].name, b=objects[b].name)  # type: ignore[arg-type]
+                 for r in asked.relations for a in made[r.a] for b in made[r.b]]  # each of three apples
     return objects, relations
-
-
-NEGATIONS = frozenset({"no", "not", "without", "except", "never", "nor", "none", "dont", "nothing"})
-NUMBERS = {"two": 2, "three": 3, "four": 4, "five": 5, "six": 6, "seven": 7, "eight": 8, "nine": 9,
-           "ten": 10, "eleven": 11, "twelve": 12}
-
-
-def _refuse_negated(ws: list[str], m: Mention) -> None:
-    """A mention with a negation among the two words before it ("no apple", "without a mug")."""
-    start = m.first if m.first >= 0 else m.start
-    said = [w for w in ws[max(0, start - 2):start] if w in NEGATIONS or w.endswith("n't")]
-    if said:
-        raise PromptError(f"the prompt says {' '.join(ws[max(0, start - 2):m.end])!r}: a scene is made of "
-                          "what it holds, so name only the objects it should hold")
-
-
-def _count(ws: list[str], m: Mention) -> int:
-    """How many objects the mention asks for: the number word or digits just before it, else one."""
-    start = m.first if m.first >= 0 else m.start
-    word = ws[start - 1] if start > 0 else ""
-    n = int(word) if word.isdigit() else NUMBERS.get(word, 1)
-    if n > MAX_OBJECTS:
-        raise PromptError(f"the prompt asks for {n} {m.noun}; a scene holds at most {MAX_OBJECTS} objects")
-    return max(n, 1)
-
-
-def _antecedent(ws: list[str], m: Mention, before: list[Mention], which: list[int],
-                objects: list[SceneObject]) -> int | None:
-    """The object an earlier mention made that the definite ``m`` names again, if exactly one fits."""
-    if m.first <= 0 or ws[m.first - 1] != "the" or m.plural:
-        return None
-    fits = {which[k] for k, e in enumerate(before)
-            if e.type == m.type and (not m.colours or objects[which[k]].color in m.colours)}
-    return fits.pop() if len(fits) == 1 else None
 
 
 def best_goal(text: str) -> tuple[Goal, float] | None:

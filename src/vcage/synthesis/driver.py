@@ -24,6 +24,7 @@ from vcage.planning.offline import OfflinePlanner
 from vcage.scene.instantiate import Instantiator, SceneConfig, SceneInstance
 from vcage.scene.layout import LayoutObject, LayoutSpec
 from vcage.scene.spec import TableSpec
+from vcage.synthesis.asked import read_prompt
 from vcage.synthesis.compositor import Compositor
 from vcage.synthesis.costs import Problem, Weights
 from vcage.synthesis.describe import best_goal, describe
@@ -224,7 +225,8 @@ def shortlist(scene_hits: Retrieval, phrases: dict[str, Retrieval], text: str) -
 def _describe_with_llm(text: str, llm: ChatBackend, scene_hits: Retrieval, phrases: dict[str, Retrieval],
                        found: dict[str, Any], sink: Sink, record: Record) -> SceneDescription:
     try:
-        choice = LLMChooser(llm).choose(text, shortlist(scene_hits, phrases, text))
+        asked = read_prompt(text)
+        choice = LLMChooser(llm).choose(text, shortlist(scene_hits, phrases, text), asked)
     except SynthesisError as exc:
         record("retrieval", "rejected", str(exc))
         raise
@@ -237,7 +239,7 @@ def _describe_with_llm(text: str, llm: ChatBackend, scene_hits: Retrieval, phras
     record("retrieval", "ok", {"chosen": [f"{c} x {t}" for t, c in choice.objects],
                                "replies": choice.replies})
     try:
-        desc, replies = LLMDescriber(llm).describe(text, choice)
+        desc, replies = LLMDescriber(llm).describe(text, choice, asked)
     except SynthesisError as exc:
         record("description", "rejected", str(exc))
         raise

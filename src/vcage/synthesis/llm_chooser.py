@@ -3,8 +3,9 @@
 The shortlist (catalog types ranked by :mod:`.retrieval`, with their descriptions) goes to the
 model, which answers ``{"objects": [{"type": ..., "count": n}], "no_match": null}`` naming shortlist
 types only, or ``{"objects": [], "no_match": "why"}`` when none suits the request: "no suitable
-object" is an answer. Names outside the shortlist, duplicates, both or neither are sent back as
-problems (:func:`~vcage.synthesis.llm_reply.ask_json`), a bounded number of times.
+object" is an answer. Names outside the shortlist, duplicates, both or neither, and a choice that
+leaves out an object the prompt names (or takes fewer than its count, or one it negates) are sent
+back as problems (:func:`~vcage.synthesis.llm_reply.ask_json`), a bounded number of times.
 """
 
 from __future__ import annotations
@@ -17,6 +18,7 @@ from pydantic import BaseModel, ConfigDict, Field
 
 from vcage.assets.catalog import CATALOG
 from vcage.backends import ChatBackend, Message
+from vcage.synthesis.asked import Asked, unmet_in_choice
 from vcage.synthesis.description import MAX_OBJECTS
 from vcage.synthesis.errors import PromptError
 from vcage.synthesis.llm_reply import MAX_REPAIRS, ReplyRejected, ask_json
@@ -75,8 +77,8 @@ def system_prompt(shortlist: Sequence[str]) -> str:
     )
 
 
-def check_choice(data: dict[str, Any], shortlist: Sequence[str]) -> tuple[tuple[tuple[str, int], ...],
-                                                                          str | None]:
+def check_choice(data: dict[str, Any], shortlist: Sequence[str],
+                 asked: Asked | None = None) -> tuple[tuple[tuple[str, int], ...], str | None]:
     reply = _ChoiceReply.model_validate(data)
     if reply.objects and reply.no_match:
         raise ValueError("give either objects or no_match, not both")
@@ -92,7 +94,11 @@ def check_choice(data: dict[str, Any], shortlist: Sequence[str]) -> tuple[tuple[
     total = sum(c.count for c in reply.objects)
     if total > MAX_OBJECTS:
         raise ValueError(f"{total} objects in all, more than the {MAX_OBJECTS} a scene may hold")
-    return tuple((c.type, c.count) for c in reply.objects), (reply.no_match or None)
+    chosen = tuple((c.type, c.count) for c in reply.objects)
+    unmet = unmet_in_choice(asked, chosen) if asked is not None and chosen else []
+    if unmet:
+        raise ValueError("; ".join(unmet))
+    return chosen, (reply.no_match or None)
 
 
 class LLMChooser:
@@ -102,13 +108,25 @@ class LLMChooser:
         self.backend = backend
         self.max_repairs = max_repairs
 
-    def choose(self, prompt: str, shortlist: Sequence[str]) -> Choice:
-        names = tuple(dict.fromkeys(n for n in shortlist if n in CATALOG))[:SHORTLIST]
+    def choose(self, prompt: str, shortlist: Sequence[str], asked: Asked | None = None) -> Choice:
+        """The model's choice; with ``asked`` (what the prompt names) the objects it names come
+        first in the shortlist and a choice that drops one, takes fewer than its count or takes
+        one the prompt negates is sent back."""
+        groups = asked.objects if asked is not None else ()
+        over = [f"{o.count} x {o.type}" for o in groups if o.count > MAX_COUNT]
+        if over:
+            raise PromptError(f"the prompt asks for {', '.join(over)}; the LLM chooser takes at most "
+                              f"{MAX_COUNT} of one type: ask for fewer, or use the offline describer "
+                              "(no --llm)")
+        named = [o.type for o in groups]
+        names = tuple(dict.fromkeys(n for n in [*named, *shortlist] if n in CATALOG))
+        names = names[:max(SHORTLIST, len(set(named)))]
         if not names:
             return Choice((), "retrieval found no candidate object for the request", names, 0)
         messages = [Message("system", system_prompt(names)), Message("user", prompt)]
         try:
-            (objects, no_match), replies = ask_json(self.backend, messages, lambda d: check_choice(d, names),
+            (objects, no_match), replies = ask_json(self.backend, messages,
+                                                    lambda d: check_choice(d, names, asked),
                                                     self.max_repairs, what="choice of objects")
         except ReplyRejected as exc:
             raise PromptError(f"{exc}; try a stronger model "

@@ -4,8 +4,9 @@ The model gets the chosen objects (types and counts, with their colours and what
 relation vocabulary with its meaning on this table, and the JSON schema of
 :class:`~vcage.synthesis.description.SceneDescription`. Its reply is validated like every
 description (unknown names, contradictions, supports that do not fit, a table too small) and must
-use exactly the chosen objects; problems are sent back a bounded number of times, then
-:class:`SceneDescriptionError`.
+use exactly the chosen objects and honour what the prompt asks for (:mod:`.asked`: every object,
+count and relation it names, none it negates); problems are sent back a bounded number of times,
+then :class:`SceneDescriptionError` names them.
 """
 
 from __future__ import annotations
@@ -16,6 +17,7 @@ from typing import Any
 
 from vcage.assets.catalog import CATALOG
 from vcage.backends import ChatBackend, Message
+from vcage.synthesis.asked import Asked, unmet_in_description
 from vcage.synthesis.description import SceneDescription, description_schema, parse_description
 from vcage.synthesis.errors import SceneDescriptionError
 from vcage.synthesis.llm_chooser import Choice
@@ -47,7 +49,7 @@ def object_lines(choice: Choice) -> str:
     return "\n".join(lines)
 
 
-def system_prompt(choice: Choice) -> str:
+def system_prompt(choice: Choice, asked: Asked | None = None) -> str:
     schema = description_schema()
     props = dict(schema.get("properties", {}))  # type: ignore[call-overload]
     props.pop("prompt", None)
@@ -58,7 +60,10 @@ def system_prompt(choice: Choice) -> str:
         "letters, digits and underscores, its type, an optional colour among the type's colours, and "
         "scale 0.7..1.3), the spatial relations the user asks for or the scene implies, and one or "
         "two sentences (text) describing the arranged scene for an image model. Use exactly these "
-        f"objects, no others:\n{object_lines(choice)}\n\nRelations: {RELATIONS}\nDo not contradict "
+        f"objects, no others:\n{object_lines(choice)}\n\nRelations: {RELATIONS}\n"
+        + (f"The prompt asks for: {asked.summary()}. Keep every one of these.\n" if asked and asked.summary()
+           else "")
+        + "Do not contradict "
         "yourself (an object rests on one thing; no cycles of left_of or in_front_of).\n\n"
         f"JSON schema:\n{json.dumps(schema, separators=(',', ':'))}\n\n"
         f"Example (for other objects):\n{json.dumps(EXAMPLE, separators=(',', ':'))}\n\n"
@@ -66,7 +71,8 @@ def system_prompt(choice: Choice) -> str:
     )
 
 
-def check_description(data: dict[str, Any], prompt: str, choice: Choice) -> SceneDescription:
+def check_description(data: dict[str, Any], prompt: str, choice: Choice,
+                      asked: Asked | None = None) -> SceneDescription:
     desc = parse_description({**data, "prompt": prompt})
     have = Counter(o.type for o in desc.objects)
     want = Counter(dict(choice.objects))
@@ -78,6 +84,9 @@ def check_description(data: dict[str, Any], prompt: str, choice: Choice) -> Scen
             + (f"; not chosen: {', '.join(extra)}" if extra else "")
             + (f"; missing: {', '.join(missing)}" if missing else "")
             + f"; use exactly: {', '.join(f'{c} x {t}' for t, c in choice.objects)}")
+    unmet = unmet_in_description(asked, desc) if asked is not None else []
+    if unmet:
+        raise SceneDescriptionError("; ".join(unmet))
     return desc
 
 
@@ -88,13 +97,16 @@ class LLMDescriber:
         self.backend = backend
         self.max_repairs = max_repairs
 
-    def describe(self, prompt: str, choice: Choice) -> tuple[SceneDescription, int]:
-        """The description and the number of replies it took."""
+    def describe(self, prompt: str, choice: Choice,
+                 asked: Asked | None = None) -> tuple[SceneDescription, int]:
+        """The description and the number of replies it took; with ``asked`` (what the prompt
+        names) a description that drops an object, a count or a relation of it, or holds an object
+        it negates, is sent back, and refused in the end."""
         if not choice.found:
             raise SceneDescriptionError(f"no objects to describe: {choice.no_match}")
-        messages = [Message("system", system_prompt(choice)), Message("user", prompt)]
+        messages = [Message("system", system_prompt(choice, asked)), Message("user", prompt)]
         try:
-            return ask_json(self.backend, messages, lambda d: check_description(d, prompt, choice),
+            return ask_json(self.backend, messages, lambda d: check_description(d, prompt, choice, asked),
                             self.max_repairs, what="scene description")
         except ReplyRejected as exc:
             raise SceneDescriptionError(f"{exc}; rephrase the "
