@@ -102,6 +102,25 @@ def test_bad_scenes_are_typed_errors(scene_dir: Path, tmp_path: Path) -> None:
         assert not (tmp_path / "x").exists()  # nothing written before the refusal
 
 
+def test_a_scene_where_the_goal_already_holds_is_refused_before_any_attempt(tmp_path: Path) -> None:
+    """Found on 2026-12-05: a goal already true in the synthesized scene spent 20 attempts on "no
+    free space"; now a typed refusal (exit 2) names the subtask and what to change, nothing written."""
+    scene = tmp_path / "scene"
+    assert RUN.invoke(app, ["synthesize", "an apple in a bowl", "--out", str(scene)]).exit_code == 0
+    for source in (["--synthesize", "an apple in a bowl"], ["--scene", str(scene)]):
+        result = RUN.invoke(app, ["generate", "put the apple in the bowl", "--episodes", "1",
+                                  "--out", str(tmp_path / "x"), *source])
+        assert result.exit_code == 2, result.output
+        assert "asks for inside(apple, bowl), which already holds in the scene" in result.output
+        assert "beside bowl" in result.output and not (tmp_path / "x").exists()
+    plan = OfflinePlanner().plan("put the apple in the bowl")
+    moved = load_scene(scene)  # the same scene with the apple beside the bowl: accepted
+    moved = replace(moved, objects=tuple(replace(o, on=None, x=o.x + 0.15) if o.type == "apple" else o
+                                         for o in moved.objects))
+    grounded, _ = ground_plan(plan, moved)
+    assert grounded.object("apple").on is None
+
+
 @pytest.mark.slow
 def test_every_attempt_can_start_from_a_scene_synthesized_for_it(tmp_path: Path) -> None:
     from vcage.pipeline.episode import attempt

@@ -154,9 +154,27 @@ def ground_plan(plan: Plan, scene: SynthesizedScene) -> tuple[Plan, SynthesizedS
         rename[s.name] = name
         taken.add(name)
     placed = tuple(replace(s, name=rename[s.name], on=rename[s.on] if s.on else None) for s in scene.objects)
+    _refuse_goals_already_met(plan, placed, scene.prompt)
     objects = [PlanObject(name=p.name, type=p.type, color=p.color, scale=p.scale, on=p.on) for p in placed]
     grounded = Plan.model_validate({**plan.model_dump(), "objects": [o.model_dump() for o in objects]})
     return grounded, replace(scene, objects=placed)
+
+
+def _refuse_goals_already_met(plan: Plan, placed: tuple[PlacedObject, ...], prompt: str) -> None:
+    """A :class:`ConfigError` when a subtask's ``on`` / ``inside`` goal holds in the scene before
+    anything has moved its object: the episode could only fail to place what is already there."""
+    support = {p.name: p.on for p in placed}
+    moved: set[str] = set()
+    for i, st in enumerate(plan.subtasks):
+        for p in st.predicates:
+            if p.name in ("on", "inside") and p.args[0] not in moved and support.get(p.args[0]) == p.args[1]:
+                raise ConfigError(
+                    f"subtask {i} ({st.description!r}) asks for {p}, which already holds in the scene "
+                    f"synthesized from {prompt!r}: the episode would have nothing to do there. Synthesize a "
+                    f"scene where {p.args[0]} is elsewhere (e.g. beside {p.args[1]}), or change the "
+                    "instruction")
+        if isinstance(st.args.get("obj"), str):
+            moved.add(st.args["obj"])
 
 
 def yaw_of(quat: Any) -> float:
