@@ -8,8 +8,11 @@ import shutil
 import subprocess
 from pathlib import Path
 
+import pytest
+
 import vcage
 from vcage import provenance
+from vcage.numerics import blas_core
 from vcage.provenance import LOCK_FILE, code, software, source_digest, versions
 
 TOP = Path(__file__).resolve().parents[1]
@@ -22,7 +25,7 @@ def test_the_checkout_s_commit_and_lock_are_recorded() -> None:
     assert recorded["commit"].removesuffix("+dirty") == head
     assert recorded["lock"] == hashlib.sha256((TOP / LOCK_FILE).read_bytes()).hexdigest()[:16]
     assert recorded["source"] == source_digest()
-    assert software() == {**versions(), **recorded}
+    assert software() == {**versions(), **recorded, "blas": blas_core()}
     assert versions()["mujoco"] == versions()["mujoco-core"]  # released together
     assert versions()["vcage"] == vcage.__version__  # one version, read by the build from the package
 
@@ -55,3 +58,28 @@ def test_a_changed_file_in_the_checkout_marks_the_commit_dirty(tmp_path: Path) -
     (clone / "elsewhere").mkdir()
     shutil.copytree(pkg, clone / "elsewhere" / "vcage")  # in a checkout, but not as its src/vcage
     assert provenance._checkout(clone / "elsewhere" / "vcage") is None
+
+
+def test_every_x86_64_run_uses_the_same_blas_kernels() -> None:
+    """OpenBLAS's kernels decide the last bits of the IK, and so where a chaotic rollout ends: vcage
+    pins them before NumPy loads them (the test process imported vcage first, via conftest), a child
+    that imports vcage first is pinned too, and one that imports NumPy first is told it was not."""
+    import os
+    import sys
+
+    from vcage.numerics import CORE, NEEDS, VARIABLE, _cpu_flags
+
+    if not set(NEEDS) <= _cpu_flags():
+        pytest.skip("the CPU lacks AVX2 or FMA: OpenBLAS chooses its kernels")
+    assert os.environ.get(VARIABLE) == CORE and blas_core() == CORE and software()["blas"] == CORE
+    env = {k: v for k, v in os.environ.items() if k != VARIABLE}
+    first = "import vcage, os; from vcage.numerics import blas_core; print(vcage.NUMERICS, '|', blas_core())"
+    out = subprocess.run([sys.executable, "-c", first], capture_output=True, text=True, env=env, check=True)
+    assert out.stdout.split() == [f"{VARIABLE}={CORE}", "|", CORE]
+    late = "import numpy, vcage; print(vcage.NUMERICS)"
+    out = subprocess.run([sys.executable, "-c", late], capture_output=True, text=True, env=env, check=True)
+    assert out.stdout.strip() == "not pinned: numpy was imported before vcage"
+    mine = subprocess.run([sys.executable, "-c", first], capture_output=True, text=True, check=True,
+                          env={**env, VARIABLE: "Sandybridge"})
+    assert mine.stdout.split() == [f"{VARIABLE}=Sandybridge", "(set", "before", "vcage)", "|", "Sandybridge"]
+

@@ -15,7 +15,11 @@ from __future__ import annotations
 import importlib
 from typing import Any
 
-from vcage.sim.gl import choose_gl_backend
+from vcage.numerics import pin
+
+NUMERICS = pin()  # before anything loads NumPy: the same BLAS kernels on every x86-64 machine
+
+from vcage.sim.gl import choose_gl_backend  # noqa: E402
 
 # MUJOCO_GL must be set before mujoco is first imported; every vcage module imports this package
 # first, so choosing the backend here covers them all.

@@ -28,8 +28,18 @@ PACKAGE = Path(__file__).resolve().parent
 
 
 def software() -> dict[str, str]:
-    """:func:`versions` and :func:`code`: everything a run records of the software it ran."""
-    return {**versions(), **code()}
+    """:func:`versions`, :func:`code` and :func:`numerics`: everything a run records of the software
+    it ran."""
+    return {**versions(), **code(), **numerics()}
+
+
+@functools.cache
+def numerics() -> dict[str, str]:
+    """``blas``: the kernels NumPy's OpenBLAS runs (:mod:`vcage.numerics`), which decide the last bits
+    of the inverse kinematics and so where a chaotic rollout ends."""
+    from vcage.numerics import blas_core
+
+    return {"blas": blas_core()}
 
 
 def versions() -> dict[str, str]:
