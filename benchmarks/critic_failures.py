@@ -46,6 +46,7 @@ os.environ.setdefault("LP_NUM_THREADS", "1")  # one rasteriser thread: a worker 
 
 import numpy as np  # noqa: E402
 
+import results  # noqa: E402
 from obs_cache import cached, open_cache  # noqa: E402
 from vcage.backends import BackendConfig  # noqa: E402
 from vcage.critics import CriticConfig, Observation, Recorder, Verdict, make_critic  # noqa: E402
@@ -167,6 +168,14 @@ def row(name: str, samples: list[Sample], accepts: list[bool]) -> str:
             f"{false_reject:>7s}")
 
 
+def rates(samples: list[Sample], accepts: list[bool]) -> dict[str, float]:
+    """Balanced accuracy, false-accept and false-reject rates (fractions) of ``accepts``."""
+    succ = [a for s, a in zip(samples, accepts, strict=True) if s.success]
+    fail = [a for s, a in zip(samples, accepts, strict=True) if not s.success]
+    far, frr = sum(fail) / len(fail), (len(succ) - sum(succ)) / len(succ)
+    return {"balanced": ((1 - frr) + (1 - far)) / 2, "false_accepts": far, "false_rejects": frr}
+
+
 HEAD = f"{'':28s} {'succ':>5s} {'fail':>5s} {'scenes':>6s}  {'bal.acc':>7s} {'FA':>7s} {'FR':>7s}"
 
 
@@ -209,6 +218,8 @@ def main() -> None:
     parser.add_argument("--vlm-record", action="store_true", help="with --vlm-tape: ask the model of the "
                         f"{VLM_ENV}_* variables and add its answers to the tape")
     parser.add_argument("--vlm-votes", type=int, default=1, help="questions per judgment (majority)")
+    parser.add_argument("--record", action="store_true", help="write the image critic's figures to "
+                        "docs/results/critic_failures.json (the results page)")
     args = parser.parse_args()
     if args.vlm_record and not args.vlm_tape:
         parser.error("--vlm-record needs --vlm-tape FILE")
@@ -244,8 +255,31 @@ def main() -> None:
         report(samples, label, [v.accept for v in verdicts])
         if args.show_errors:
             errors(samples, verdicts)
+        if args.record and label == "image":
+            _record(args, samples, [v.accept for v in verdicts])
     if args.vlm_tape:
         judge_vlm(samples, Path(args.vlm_tape), args.vlm_record, args.vlm_votes, args.show_errors)
+
+
+def _record(args: argparse.Namespace, samples: list[Sample], accepts: list[bool]) -> None:
+    r = rates(samples, accepts)
+    succ = sum(s.success for s in samples)
+    fails = len(samples) - succ
+    fa = sum(a for s, a in zip(samples, accepts, strict=True) if not s.success)
+    fr = sum(not a for s, a in zip(samples, accepts, strict=True) if s.success)
+    path = results.record(
+        "critic_failures", "Image critic on silent failures",
+        "Does the offline image critic reject subtasks that silently failed (injected motion faults) and "
+        "accept those that succeeded, with the oracle as ground truth?",
+        {"balanced accuracy": f"{r['balanced']:.1%}",
+         "false accepts (failures accepted)": f"{r['false_accepts']:.1%} ({fa} of {fails})",
+         "false rejects (successes rejected)": f"{r['false_rejects']:.1%} ({fr} of {succ})",
+         "accepting everything": "50.0% balanced accuracy"},
+        f"{succ} successes and {fails} failures (oracle labels), "
+        f"{len({(s.goal, s.scene) for s in samples})} distinct scenes of the goals {', '.join(args.goals)}, "
+        f"seeds {args.first_seed}-{args.first_seed + args.seeds - 1}, {args.faults_per_seed} injected faults "
+        "per seed")
+    print(f"recorded in {path}")
 
 
 def errors(samples: list[Sample], verdicts: list[Verdict]) -> None:
