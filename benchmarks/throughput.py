@@ -39,6 +39,7 @@ os.environ.setdefault("LP_NUM_THREADS", "1")  # one rasteriser thread: the worke
 
 import numpy as np  # noqa: E402
 
+import results  # noqa: E402
 from vcage.data import DatasetReader  # noqa: E402
 from vcage.pipeline.config import GenerateConfig  # noqa: E402
 from vcage.pipeline.episode import PHASES, Timing  # noqa: E402
@@ -192,6 +193,8 @@ def main() -> None:
     parser.add_argument("--out", type=Path, default=Path("/tmp/vcage-throughput"))
     parser.add_argument("--noslip-iterations", type=int, default=None,
                         help="override SimConfig.noslip_iterations (3 was the default before)")
+    parser.add_argument("--record", action="store_true", help="write the overall figures to "
+                        "docs/results/throughput.json (the results page)")
     args = parser.parse_args()
     rows = []
     for goal in args.goals:
@@ -206,6 +209,21 @@ def main() -> None:
           f"one worker, LP_NUM_THREADS={os.environ['LP_NUM_THREADS']}, {os.cpu_count()} cores, "
           f"load average {load[0]:.2f} {load[1]:.2f} {load[2]:.2f}\n")
     _print(rows, peak_mb)
+    if args.record and args.noslip_iterations is None:
+        total = _total(rows)
+        path = results.record(
+            "throughput", "Throughput of verified episodes",
+            "How many verified episodes (accepted, and confirmed by the oracle) does the default pipeline "
+            "make per hour of one core, and how far is it from the floor of raw physics and bare rendering?",
+            {"verified episodes per core-hour (wall)": f"{total.verified / (total.wall / 3600):.0f}",
+             "verified episodes per CPU-hour (getrusage)": f"{total.verified / (total.cpu / 3600):.0f}",
+             "wall seconds per accepted episode": f"{total.wall / max(total.accepted, 1):.2f}",
+             "pipeline wall / floor (raw mj_step + bare render)": f"{total.wall / total.floor:.2f}",
+             "peak RSS of the worker": f"{peak_mb:.0f} MiB"},
+            f"{total.accepted} accepted episodes ({total.verified} confirmed by the oracle) of "
+            f"{total.attempts} attempts, goals {', '.join(args.goals)}, seed {args.seed}; one worker on one "
+            f"core, two 128x128 cameras; load average {load[0]:.2f} at the end")
+        print(f"recorded in {path}")
 
 
 if __name__ == "__main__":
