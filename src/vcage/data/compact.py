@@ -79,6 +79,20 @@ def kept_tasks(tasks: list[str] | None, rows: list[dict[str, Any]]) -> list[str]
     return list(dict.fromkeys(used))
 
 
+def info_for(static: dict[str, Any], rows: list[dict[str, Any]], tasks: list[str]) -> dict[str, Any]:
+    """``meta/info.json`` for a dataset that holds ``rows`` (episodes 0..n-1) and ``tasks``."""
+    return {**static, "total_episodes": len(rows), "total_frames": sum(int(r["length"]) for r in rows),
+            "total_tasks": len(tasks) if rows else 0, "splits": {"train": f"0:{len(rows)}"}}
+
+
+def stats_for(rows: list[dict[str, Any]]) -> dict[str, st.Stats]:
+    """The dataset's statistics: the per-episode statistics of ``rows`` merged."""
+    stats: dict[str, st.Stats] = {}
+    for row in rows:
+        stats = st.merge(stats, st.from_row(row))
+    return stats
+
+
 def compact(scan: Scan, found: VerifyReport, quarantine: str, render: Render | None = None) -> Compaction:
     """Drop the episodes ``found`` names as damaged (and those whose row is lost), keep every other
     one renumbered, and commit that crash-safely; see the module docstring.
@@ -259,6 +273,7 @@ def _render_again(scan: Scan, reasons: dict[int, list[str]], scratch_dir: Path, 
     static = scan.static
     assert static is not None
     fps = int(static["fps"])
+    encoder = video.encoder_for({static["features"][k]["info"]["video.codec"] for k in cameras})
     out: dict[int, dict[str, Path]] = {}
     for i in sorted(reasons):
         row = scan.rows.get(i)
@@ -272,7 +287,6 @@ def _render_again(scan: Scan, reasons: dict[int, list[str]], scratch_dir: Path, 
             if extras is None or states is None:
                 continue
             frames = render(extras, states)
-            encoder = video.encoder_for({static["features"][k]["info"]["video.codec"] for k in cameras})
             clips = {}
             for key in cameras:
                 recorded = row.get(digest.video_column(key))
@@ -295,16 +309,11 @@ def _stage_meta(scan: Scan, staging: Path, rows: list[dict[str, Any]], tasks: li
     """``info.json``, ``stats.json``, ``tasks.parquet``, the episodes files and the card for ``rows``."""
     static = scan.static
     assert static is not None
-    frames = sum(int(r["length"]) for r in rows)
-    info = {**static, "total_episodes": len(rows), "total_frames": frames,
-            "total_tasks": len(tasks) if rows else 0, "splits": {"train": f"0:{len(rows)}"}}
+    info = info_for(static, rows, tasks)
     write_json(_staged(staging, layout.INFO_PATH), info)
     put = [layout.INFO_PATH]
     if rows:
-        stats: dict[str, st.Stats] = {}
-        for row in rows:
-            stats = st.merge(stats, st.from_row(row))
-        write_json(_staged(staging, layout.STATS_PATH), st.to_json(stats))
+        write_json(_staged(staging, layout.STATS_PATH), st.to_json(stats_for(rows)))
         write_table(_staged(staging, layout.TASKS_PATH), tasks_table(tasks))
         put += [layout.STATS_PATH, layout.TASKS_PATH]
         by_chunk: dict[int, list[dict[str, Any]]] = {}

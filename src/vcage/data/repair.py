@@ -26,7 +26,7 @@ import pyarrow.compute as pc
 from vcage.data import digest, layout, video
 from vcage.data import stats as st
 from vcage.data.card import dataset_card
-from vcage.data.compact import Render, compact, finish, kept_tasks
+from vcage.data.compact import Render, compact, finish, info_for, kept_tasks, stats_for
 from vcage.data.files import (
     BACKUP_MARK,
     TMP_MARK,
@@ -200,9 +200,7 @@ def _rewrite(scan: Scan, before: VerifyReport, found: VerifyReport, kept: int,
     assert static is not None
     rows = [scan.rows[i] for i in range(kept)]
     tasks = kept_tasks(scan.tasks, rows)
-    frames = sum(int(r["length"]) for r in rows)
-    info = {**static, "total_episodes": kept, "total_frames": frames, "total_tasks": len(tasks),
-            "splits": {"train": f"0:{kept}"}}
+    info = info_for(static, rows, tasks)
     keep = _files_of(scan, range(kept))
     doomed = _files_of(scan, range(kept, scan.episodes))
     aside = Quarantine(root)
@@ -211,15 +209,12 @@ def _rewrite(scan: Scan, before: VerifyReport, found: VerifyReport, kept: int,
     rewritten = [*_cut_shared(scan, kept, sorted(keep & doomed)), *_set_aside_bad_lines(root),
                  layout.INFO_PATH]
     write_json(root / layout.INFO_PATH, info)  # the commit point: nothing beyond is read now
-    stats: dict[str, st.Stats] = {}
-    for row in rows:
-        stats = st.merge(stats, st.from_row(row))
     by_file: dict[str, list[dict[str, Any]]] = defaultdict(list)
     for i, row in enumerate(rows):
         by_file[scan.row_files[i]].append(row)
     removed: list[str] = []
     if kept:
-        write_json(root / layout.STATS_PATH, st.to_json(stats))
+        write_json(root / layout.STATS_PATH, st.to_json(stats_for(rows)))
         write_table(root / layout.TASKS_PATH, tasks_table(tasks))
         rewritten += [layout.STATS_PATH, layout.TASKS_PATH]
         for rel, file_rows in sorted(by_file.items()):
