@@ -48,13 +48,17 @@ def add(w: DatasetWriter, length: int, seed: int) -> int:
     return w.add_episode(frames, {CAM: video}, task=f"task {seed % 2}", extras=extras, arrays=arrays)
 
 
-@pytest.fixture(scope="module")
-def pristine(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    root = tmp_path_factory.mktemp("integrity") / "ds"
+def write_dataset(root: Path) -> Path:
+    """The packed dataset of :data:`LENGTHS` these tests corrupt, written at ``root``."""
     with open_writer(root) as w:
         for seed, length in enumerate(LENGTHS):
             add(w, length, seed)
     return root
+
+
+@pytest.fixture(scope="module")
+def pristine(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    return write_dataset(tmp_path_factory.mktemp("integrity") / "ds")
 
 
 @pytest.fixture()

@@ -12,7 +12,7 @@ from typing import Any
 import pytest
 
 from data.content import contents_by_episode
-from data.test_integrity import LENGTHS, add, episode_files, open_writer, truncate
+from data.test_integrity import episode_files, open_writer, truncate, write_dataset
 from vcage.data import DatasetReader, compact, layout, video
 from vcage.data.repair import repair
 from vcage.data.verify import verify
@@ -21,11 +21,7 @@ from vcage.errors import CorruptDatasetError
 
 @pytest.fixture(scope="module")
 def pristine(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    root = tmp_path_factory.mktemp("repair-crash") / "ds"
-    with open_writer(root) as w:
-        for seed, length in enumerate(LENGTHS):
-            add(w, length, seed)
-    return root
+    return write_dataset(tmp_path_factory.mktemp("repair-crash") / "ds")
 
 
 class CrashError(Exception):
