@@ -22,6 +22,7 @@ from vcage.critics.vlm import ENV_PREFIX as VLM_ENV_PREFIX
 from vcage.errors import ConfigError
 from vcage.planning import LLM_ENV_PREFIX, PlannerConfig
 from vcage.scene.instantiate import SceneConfig
+from vcage.skills.recovery import RecoveryConfig
 from vcage.subtasks.chains import SubtaskChain
 from vcage.synthesis.scene_file import SynthesisRequest, SynthesizedScene
 
@@ -79,6 +80,9 @@ class GenerateConfig:
     # a prompt to synthesize a new scene from for every attempt (seeded by the attempt's seed); None:
     # the plan's layout (or ``synthesized``). Stored only when set
     synthesis: SynthesisRequest | None = None
+    # recovery data (`vcage.skills.recovery`): executed commands pushed off the plan on a share of the
+    # motion segments, the plan's command kept as the action; None: off. Stored only when set
+    recovery: RecoveryConfig | None = None
 
     def __post_init__(self) -> None:
         seed = self.seed
@@ -122,6 +126,8 @@ class GenerateConfig:
             data["chain"] = self.chain.to_dict()
         if self.synthesis is not None:
             data["synthesis"] = self.synthesis.to_dict()
+        if self.recovery is not None:
+            data["recovery"] = self.recovery.to_dict()
         return data
 
     def data_dict(self) -> dict[str, Any]:
@@ -140,7 +146,7 @@ class GenerateConfig:
         return from_fields(cls, data, planner=PlannerConfig, scene=SceneConfig, critic=CriticConfig,
                            render=RenderConfig, sim=SimConfig, randomization=Randomization,
                            executor=ExecutorConfig, synthesized=SynthesizedScene,
-                           chain=SubtaskChain, synthesis=SynthesisRequest)
+                           chain=SubtaskChain, synthesis=SynthesisRequest, recovery=RecoveryConfig)
 
     def episode_seed(self, episode: int, attempt: int) -> int:
         """The seed of an attempt: derived from the run seed, the episode and the attempt index."""

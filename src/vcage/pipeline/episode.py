@@ -31,6 +31,7 @@ from vcage.sim.world import World
 from vcage.skills.base import Skills
 from vcage.skills.playback import Player, Recording
 from vcage.skills.reachability import reach_map
+from vcage.skills.recovery import Perturbation, move_start
 
 # Where a run's time goes, phase by phase, in the order an episode meets them. An attempt fills
 # placement .. critic_judge; the driver adds planning (once per run) and what an accepted episode
@@ -163,8 +164,12 @@ def _execute(plan: Plan, seed: int, cfg: GenerateConfig, critic: Critic | None, 
         assert instance.stability is not None
         return Attempt(seed, Stage.SCENE, instance.stability.reason(), scene)
     try:
+        perturbation = None
+        if cfg.recovery is not None and cfg.recovery.active:
+            perturbation = Perturbation(cfg.recovery, seed)
+            move_start(world, perturbation)
         initial = world.get_state()
-        skills = Skills(world, Player(world, record_states=True))
+        skills = Skills(world, Player(world, record_states=True, perturbation=perturbation))
         t0 = time.perf_counter()
         renderer = (Renderer(world, *cfg.render.critic_size, cfg.render.mesh_detail)
                     if critic is not None and critic.needs_views else None)

@@ -112,7 +112,7 @@ class TrainConfig:
     """One training run: the policy, its sizes, the optimisation and the observation features."""
 
     policy: str = "diffusion"
-    steps: int = 15000  # 3,000 left a press-the-bell policy at 10% (docs/BENCHMARKS.md)
+    steps: int = 15000  # 3,000 left a press-the-bell policy at 10% (docs/journal/benchmarks.md)
     batch_size: int = 64
     lr: float = 1e-3  # AdamW, linear warm-up then cosine decay to 0
     weight_decay: float = 1e-6
@@ -123,11 +123,16 @@ class TrainConfig:
     observation_keys: tuple[str, ...] | None = None  # None: DEFAULT_OBSERVATIONS the dataset has
     action_key: str = ACTION  # one of ACTIONS
     obs_norm: str = "min_max"  # observations to [-1, 1] (min_max) or to zero mean, unit std (mean_std)
+    # the smallest normalisation scale of a value (observations and actions), in its own units: rotation-
+    # matrix columns ``rotation_floor``, every other value (positions in m, joints in rad, widths)
+    # ``norm_floor``; 0 turns a floor off (a value that never moves is then only centred)
+    norm_floor: float = 0.01
+    rotation_floor: float = 0.05
     rotations: str = "rot6d"  # quaternions read as rotation-matrix columns (see vcage.policy.encoding)
     n_obs_steps: int = 2
     # frames between two observed frames: the window reaches (n_obs_steps - 1) * obs_stride frames back,
     # so a few frames can span a whole motion (the way down to a button and the way back up look
-    # alike over 2 frames; docs/BENCHMARKS.md)
+    # alike over 2 frames; docs/journal/benchmarks.md)
     obs_stride: int = 1
     horizon: int = 16
     n_action_steps: int = 8
@@ -162,6 +167,10 @@ class TrainConfig:
                 or self.warmup_steps < 0:
             raise ConfigError(f"warmup_steps must be a non-negative integer, got {self.warmup_steps!r}")
         _positive("train", lr=self.lr, grad_clip=self.grad_clip, ema_power=self.ema_power)
+        for name in ("norm_floor", "rotation_floor"):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, int | float) or not 0 <= value < 1:
+                raise ConfigError(f"{name} must be a number in [0, 1), got {value!r}")
         if not 0 <= self.weight_decay < 1:
             raise ConfigError(f"weight_decay must be in [0, 1), got {self.weight_decay}")
         if not 0 <= self.ema_max_decay < 1:

@@ -103,6 +103,15 @@ class VectorEncoder:
     def size(self) -> int:
         return self.raw_size + len(self.starts) * (ROT6D_SIZE - 4)
 
+    def rotation_mask(self) -> np.ndarray:
+        """(size,) bool: which values of the encoded vector are rotation-matrix columns (or, with
+        ``rotations="quaternion"``, none: a quaternion passes through as four plain values)."""
+        mask, shift = np.zeros(self.size, dtype=bool), 0
+        for s in self.starts:
+            mask[s + shift:s + shift + ROT6D_SIZE] = True
+            shift += ROT6D_SIZE - 4
+        return mask
+
     def __call__(self, raw: np.ndarray) -> np.ndarray:
         """(..., raw_size) stored values -> (..., size) float32 inputs."""
         x = np.asarray(raw, dtype=np.float32)

@@ -3,7 +3,7 @@
 On a GPU, one step of the diffusion U-Net launches thousands of small kernels (convolutions, group
 norms, the optimiser's and the EMA's per-tensor updates), so its time is the launches' whatever the
 batch: a lent H200 ran one run alone at 20.0 steps per second at batch 256 and 21.4 at 1,024, and
-twenty runs sharing it at 3.2-3.6 each (``docs/BENCHMARKS.md``). A CUDA graph records the step's
+twenty runs sharing it at 3.2-3.6 each (``docs/journal/benchmarks.md``). A CUDA graph records the step's
 kernels once and replays them with one launch.
 
 What changes from step to step is copied into fixed device buffers before each replay: the batch's

@@ -11,7 +11,7 @@ classifier head learns to name the subtask from the window (cross-entropy, added
 Training conditions on the demonstration's subtask; at inference the runner asks the classifier
 (:mod:`vcage.policy.inference`). Without it, a state where one subtask has ended looks much like
 the one the episode began in (the arm back at its start, the gripper open), and a policy was seen
-to do the first subtask again instead of the next (``docs/BENCHMARKS.md``).
+to do the first subtask again instead of the next (``docs/journal/benchmarks.md``).
 """
 
 from __future__ import annotations

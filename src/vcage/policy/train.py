@@ -13,7 +13,7 @@ import contextlib
 import math
 import os
 import time
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, fields
 from pathlib import Path
 from typing import Any
@@ -32,9 +32,10 @@ from vcage.policy.checkpoint import (
     save_checkpoint,
 )
 from vcage.policy.config import TrainConfig
-from vcage.policy.dataset import TrainingData, load_training_data
+from vcage.policy.dataset import FeatureSpec, TrainingData, load_training_data
 from vcage.policy.devices import torch_device
 from vcage.policy.ema import Ema
+from vcage.policy.encoding import VectorEncoder
 from vcage.policy.errors import CheckpointError, PolicyError, TrainingDivergedError
 from vcage.policy.graphed import GraphedStep
 from vcage.policy.models import Policy, make_policy
@@ -222,6 +223,13 @@ def _resume_from(out: Path, config: TrainConfig, resume: bool) -> dict[str, Any]
     return payload
 
 
+def floors(features: Sequence[FeatureSpec], config: TrainConfig) -> np.ndarray:
+    """The smallest normalisation scale of each value the policy reads or writes: ``rotation_floor``
+    for rotation-matrix columns, ``norm_floor`` for the rest (see :mod:`vcage.policy.normalize`)."""
+    mask = VectorEncoder(features, config.rotations).rotation_mask()
+    return np.where(mask, config.rotation_floor, config.norm_floor)
+
+
 def train(dataset: str | Path, out: str | Path, config: TrainConfig, *, resume: bool = False,
           device: str = "cpu", threads: int | None = None, progress: Progress | None = None,
           keep: int | None = None, graph: bool = False) -> TrainSummary:
@@ -245,8 +253,9 @@ def train(dataset: str | Path, out: str | Path, config: TrainConfig, *, resume: 
     if saved is not None:
         normalization = {k: Normalizer.from_dict(v) for k, v in saved["normalization"].items()}
     else:
-        normalization = {"obs": Normalizer.fit(data.obs, config.obs_norm),
-                         "action": Normalizer.fit(data.action, "min_max")}
+        normalization = {
+            "obs": Normalizer.fit(data.obs, config.obs_norm, floors(data.obs_features, config)),
+            "action": Normalizer.fit(data.action, "min_max", floors([data.action_feature], config))}
     with deterministic(threads, where):
         if graph and where.type != "cuda":
             raise ConfigError(f"a CUDA graph of the training step needs a CUDA device, not {device!r}")

@@ -2,6 +2,8 @@
 
 Per control step the player records joint positions, gripper width, the TCP pose, and the
 commanded action (7 arm joint targets and the gripper command), which is what a dataset stores.
+With a :class:`~vcage.skills.recovery.Perturbation` the executed arm command of some segments is
+pushed off the plan while the recorded action stays the plan's (recovery data).
 """
 
 from __future__ import annotations
@@ -14,6 +16,7 @@ import numpy as np
 from vcage.geometry import mat_to_quat
 from vcage.sim.world import World
 from vcage.skills.motion import MotionPlan, min_jerk
+from vcage.skills.recovery import Perturbation
 
 StepHook = Callable[[World], None]
 
@@ -45,10 +48,12 @@ class Recording:
 class Player:
     """Interpolates waypoints with minimum-jerk timing and steps the world once per control tick."""
 
-    def __init__(self, world: World, record: bool = True, record_states: bool = False) -> None:
+    def __init__(self, world: World, record: bool = True, record_states: bool = False,
+                 perturbation: Perturbation | None = None) -> None:
         self.world = world
         self.record = record
         self.record_states = record_states  # also keep every step's full state (for replay/video)
+        self.perturbation = perturbation  # pushes the executed command of some segments (recovery data)
         self.recording = Recording()
         self.hooks: list[StepHook] = []
         robot = world.robot
@@ -62,8 +67,10 @@ class Player:
             n = max(1, round(wp.duration / dt))
             start_q, start_g = self.q_cmd.copy(), self.gripper_cmd
             s = min_jerk(np.arange(1, n + 1) / n)
+            push = None if self.perturbation is None else self.perturbation.offsets(n, len(start_q))
             for k in range(n):
-                self._tick(start_q + s[k] * (wp.q - start_q), start_g + s[k] * (wp.gripper - start_g))
+                self._tick(start_q + s[k] * (wp.q - start_q), start_g + s[k] * (wp.gripper - start_g),
+                           None if push is None else push[k])
             for _ in range(round(wp.hold / dt)):
                 self._tick(wp.q, wp.gripper)
         self.recording.skills.append((plan.skill, first, len(self.recording)))
@@ -72,7 +79,9 @@ class Player:
         for _ in range(max(1, round(seconds / self.world.control_dt))):
             self._tick(self.q_cmd, self.gripper_cmd)
 
-    def _tick(self, q: np.ndarray, gripper: float) -> None:
+    def _tick(self, q: np.ndarray, gripper: float, push: np.ndarray | None = None) -> None:
+        """One control step towards the command ``q``, ``gripper``, executed as ``q + push``; the
+        command itself (never the push) is what the recording keeps and the next segment starts from."""
         world = self.world
         self.q_cmd, self.gripper_cmd = np.asarray(q, dtype=float), float(gripper)
         robot = world.robot
@@ -88,6 +97,6 @@ class Player:
             rec.time.append(float(data.time))
             if self.record_states:
                 rec.states.append(world.get_state())
-        world.step(robot.ctrl(self.q_cmd, self.gripper_cmd))
+        world.step(robot.ctrl(self.q_cmd if push is None else self.q_cmd + push, self.gripper_cmd))
         for hook in self.hooks:
             hook(world)
