@@ -41,3 +41,30 @@ def test_unknown_modes_and_empty_frames_are_refused() -> None:
         Normalizer.fit(frames(), "zscore")
     with pytest.raises(ConfigError, match="T >= 1"):
         Normalizer.fit(np.zeros((0, 3)), "min_max")
+
+
+def test_a_floor_keeps_a_dimension_that_barely_moves_from_being_stretched() -> None:
+    x = frames()
+    x[:, 0] = 0.3 + np.linspace(0, 1.5e-4, len(x))  # a pad's tilt in clean demonstrations
+    bare, floored = Normalizer.fit(x, "min_max"), Normalizer.fit(x, "min_max", floor=0.01)
+    deviation = x[:1].copy()
+    deviation[0, 0] += 1e-3  # one milliradian off in closed loop
+    assert abs(bare.normalize(deviation)[0, 0]) > 10  # far outside what the network was trained on
+    assert abs(floored.normalize(deviation)[0, 0]) < 0.2
+    assert floored.scale[2] == bare.scale[2]  # a dimension that moves more keeps its own range
+    assert floored.scale[1] == pytest.approx(0.01)  # a constant one gets the floor, not 1
+    np.testing.assert_allclose(floored.unnormalize(floored.normalize(x)), x, rtol=1e-6, atol=1e-5)
+    with pytest.raises(ConfigError, match="floor"):
+        Normalizer.fit(x, "min_max", floor=-1.0)
+
+
+def test_rotation_columns_get_their_own_floor() -> None:
+    from vcage.policy import TrainConfig
+    from vcage.policy.dataset import FeatureSpec
+    from vcage.policy.train import floors
+
+    pose = FeatureSpec("observation.ee_pose", 7, ("x", "y", "z", "qw", "qx", "qy", "qz"))
+    config = TrainConfig(norm_floor=0.01, rotation_floor=0.05)
+    np.testing.assert_array_equal(floors([pose], config), [0.01] * 3 + [0.05] * 6)
+    with pytest.raises(ConfigError, match="norm_floor"):
+        TrainConfig(norm_floor=-0.1)
