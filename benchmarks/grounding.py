@@ -175,6 +175,8 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--data", type=Path, default=DATA)
     ap.add_argument("--verbose", action="store_true", help="print every sentence that was not right")
+    ap.add_argument("--record", action="store_true", help="write the figures to docs/results/grounding.json "
+                    "(the results page)")
     args = ap.parse_args()
     cases = load(args.data)
     t0 = time.perf_counter()
@@ -192,6 +194,29 @@ def main() -> None:
         for r in bad:
             text = r.case.text if len(r.case.text) <= 90 else r.case.text[:87] + "..."
             print(f"  {r.case.id} [{r.outcome}{', echo' if r.echo else ''}] {text!r}: {r.detail[:160]}")
+    if args.record:
+        _record(results, cases)
+
+
+def _record(results: list[Result], cases: list[Case]) -> None:
+    import results as results_file  # benchmarks/results.py, beside this script
+
+    c = Counter(r.outcome for r in results)
+    want_plan = sum(r.case.expect != "refuse" for r in results)
+    path = results_file.record(
+        "grounding", "Grounding with the offline planner",
+        "Does the offline planner turn a hand-written sentence into the right plan, or refuse it when it "
+        "cannot be grounded, without ever running a wrong plan? The planner's rules were written with "
+        "many of these sentences in view, so this is a regression figure, not a held-out one.",
+        {"wrong plans": f"{c['wrong_plan']}/{len(results)}",
+         "correct plans (of sentences that should plan)": f"{c['correct_plan']}/{want_plan}",
+         "correct refusals (of sentences that should be refused)":
+             f"{c['correct_refusal']}/{len(results) - want_plan}",
+         "groundable sentences refused": f"{c['refused_groundable']}/{want_plan}",
+         "crashes": str(c["crash"])},
+        f"{len(cases)} sentences in {len({r.case.category for r in results})} categories "
+        f"({want_plan} to plan, {len(results) - want_plan} to refuse)")
+    print(f"recorded in {path}")
 
 
 if __name__ == "__main__":

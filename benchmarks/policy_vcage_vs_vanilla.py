@@ -72,8 +72,8 @@ SUITE = (
 )
 QUICK_SUITE = ("press the bell",)
 # what the policies observe unless told: the tool's pose and the poses of the plan's objects, without the
-# joint state (with it, tool-pose policies drifted where the IK left the elbow; docs/BENCHMARKS.md, "joint
-# targets or tool poses")
+# joint state (with it, tool-pose policies drifted where the IK left the elbow; docs/journal/benchmarks.md,
+# "joint targets or tool poses")
 DEFAULT_OBS = ("observation.ee_pose", "observation.environment_state")
 METHODS = ("vcage", "vanilla")
 
@@ -305,7 +305,9 @@ def bootstrap_gap(outcomes: dict[str, dict[str, np.ndarray]], draws: int, rng: n
     return gap, float(low), float(high)
 
 
-def report(results: list[dict[str, Any]], noise: dict[str, float], draws: int) -> None:
+def report(results: list[dict[str, Any]], noise: dict[str, float], draws: int) -> dict[str, Any]:
+    """Print the table (per task and method, the averages, the paired gap); return its figures."""
+    summary: dict[str, Any] = {"tasks": {}, "avg": {}, "gap": None}
     by: dict[str, dict[str, list[dict[str, Any]]]] = {}
     for r in results:
         by.setdefault(r["task"], {}).setdefault(r["method"], []).append(r)
@@ -328,6 +330,7 @@ def report(results: list[dict[str, Any]], noise: dict[str, float], draws: int) -
             fits = [r["fit"] for r in runs if r.get("fit")]
             fit = f"{sum(f['successes'] for f in fits)}/{sum(f['episodes'] for f in fits)}" if fits \
                 else "n/a"
+            summary["tasks"].setdefault(task, {})[method] = (s, n)
             print(f"{task[:48]:48s} {method:8s} {s / n:6.1%} {f'[{low:.0%}, {high:.0%}]':>15s} {n:5d} "
                   f"{progress:9.2f} {fit:>9s} {noise.get(task, float('nan')):14.1%}")
     print(f"\n{'':14s} {'Avg SR':>8s} {'Top-5 (tasks)':>14s} {'Top-10 (tasks)':>15s} "
@@ -337,6 +340,7 @@ def report(results: list[dict[str, Any]], noise: dict[str, float], draws: int) -
         if not r:
             continue
         avg = float(np.mean([np.mean(v) for v in r.values()]))
+        summary["avg"][method] = avg
         cells = [top_k(r, k, how) for how in ("tasks", "checkpoints") for k in (5, 10)]
         shown = ["n/a" if c is None else f"{c:.1%}" for c in cells]
         print(f"{method:14s} {avg:8.1%} {shown[0]:>14s} {shown[1]:>15s} {shown[2]:>14s} {shown[3]:>15s}")
@@ -344,6 +348,7 @@ def report(results: list[dict[str, Any]], noise: dict[str, float], draws: int) -
               and m["vcage"].shape == m["vanilla"].shape}
     if paired:
         gap, low, high = bootstrap_gap(paired, draws, np.random.default_rng(0))
+        summary["gap"] = (gap, low, high, len(paired))
         print(f"\nV-CAGE - Vanilla success gap: {gap:+.1%} (paired bootstrap 95%: [{low:+.1%}, {high:+.1%}], "
               f"{len(paired)} tasks)")
         gaps = [paired[t]["vcage"].mean() - paired[t]["vanilla"].mean() for t in paired]
@@ -352,6 +357,7 @@ def report(results: list[dict[str, Any]], noise: dict[str, float], draws: int) -
             corr = np.corrcoef(gaps, noises)[0, 1]
             print(f"correlation of the per-task gap with Vanilla's label noise: {corr:+.2f}")
         subtask_gaps(by, paired, draws)
+    return summary
 
 
 def subtask_gaps(by: dict[str, dict[str, list[dict[str, Any]]]], paired: dict[str, Any], draws: int) -> None:
@@ -455,6 +461,12 @@ def main() -> None:
                         "the table from --ledger alone")
     parser.add_argument("--ledger", type=Path, default=None,
                         help="one JSON file per finished task: skip the tasks it holds, add those finished")
+    parser.add_argument("--record", action="store_true", help="with --stage report: write the whole table's "
+                        "figures to docs/results/policy_table1.json (the results page)")
+    parser.add_argument("--ledger-commit", default=None, help="with --record: the commit whose code made the "
+                        "ledger (its entries hold only a fingerprint of the code)")
+    parser.add_argument("--ledger-patch", default=None, help="with --record: what was applied to that "
+                        "commit, if anything (recorded as COMMIT+patched with this note)")
     parser.add_argument("--device", default="cpu", help="training device: cpu, or cuda on a GPU machine")
     parser.add_argument("--cuda-graph", action="store_true",
                         help="with --device cuda: capture each run's training step as a CUDA graph")
@@ -482,7 +494,10 @@ def main() -> None:
     if args.stage == "report":
         if args.ledger is None:
             raise SystemExit("--stage report reads the table from --ledger DIR: name the folder")
-        report_ledger(args.ledger, tasks, args.bootstrap)
+        made = None
+        if args.record:
+            made = ledger_made(args.ledger_commit, args.ledger_patch)
+        report_ledger(args.ledger, tasks, args.bootstrap, made)
         return
     if args.stage == "train":
         train_stage(tasks, args)
@@ -681,9 +696,30 @@ def entry_curves(entry: dict[str, Any]) -> dict[tuple[str, str, int], tuple[list
             for c in entry["curves"]}
 
 
-def report_ledger(ledger: Path, tasks: list[str], draws: int) -> None:
+def ledger_made(commit: str | None, patch: str | None) -> dict[str, str]:
+    """The provenance of a ledger's figures: the full hash of the commit that made them (``git
+    rev-parse``), ``+patched`` with a note when something was applied to it."""
+    import subprocess
+
+    if not commit:
+        raise SystemExit("--record needs --ledger-commit: the ledger's entries name only a fingerprint of "
+                         "the code that made them, and a recorded figure names its commit")
+    done = subprocess.run(["git", "rev-parse", "--verify", f"{commit}^{{commit}}"], capture_output=True,
+                          text=True, check=False, cwd=Path(__file__).resolve().parent)
+    if done.returncode != 0:
+        raise SystemExit(f"--ledger-commit {commit!r} is not a commit of this repository")
+    made = {"commit": done.stdout.strip() + ("+patched" if patch else "")}
+    if patch:
+        made["note"] = patch
+    return made
+
+
+def report_ledger(ledger: Path, tasks: list[str], draws: int, made: dict[str, str] | None = None) -> None:
     """The table and curves of the ledger's entries for ``tasks``, which must share code and settings;
-    a table short of tasks says so first."""
+    a table short of tasks says so first. ``record`` writes the table's figures to
+    ``docs/results/policy_table1.json`` (refused for a partial table), stamped with the ledger's code
+    fingerprint and the date of its last entry, not with the code that reports it (``made``: the commit
+    that made the ledger, from :func:`ledger_made`; None: nothing is recorded)."""
     entries = [e for t in tasks if (e := read_entry(ledger, t, None)) is not None]
     if not entries:
         raise SystemExit(f"{ledger} holds none of the tasks {tasks}")
@@ -703,13 +739,45 @@ def report_ledger(ledger: Path, tasks: list[str], draws: int) -> None:
         if kinds:
             print(f"{e['task']}: what the oracle finds wrong in Vanilla's demos: "
                   + ", ".join(f"{what} in {n}" for what, n in kinds.items()))
-    report([r for e in entries for r in e["results"]], {e["task"]: e["noise"] for e in entries}, draws)
+    summary = report([r for e in entries for r in e["results"]], {e["task"]: e["noise"] for e in entries},
+                     draws)
     curves: dict[tuple[str, str, int], tuple[list[int], list[float]]] = {}
     for e in entries:
         curves |= entry_curves(e)
     path = plot_curves(curves, [e["task"] for e in entries], ledger / "learning_curves.png")
     if path is not None:
         print(f"\nlearning curves: {path}")
+    if made is not None:
+        if missing:
+            raise SystemExit("--record writes whole tables only: the ledger lacks " + ", ".join(missing))
+        record_table(entries, summary, made)
+
+
+def record_table(entries: list[dict[str, Any]], summary: dict[str, Any], made: dict[str, str]) -> None:
+    import results
+
+    settings = entries[0]["settings"]
+    names = {"vcage": "V-CAGE", "vanilla": "Vanilla"}
+    figures = {f"Avg SR {names[m]}": f"{avg:.1%}" for m, avg in summary["avg"].items()}
+    if summary["gap"] is not None:
+        gap, low, high, _ = summary["gap"]
+        figures["V-CAGE - Vanilla gap (paired bootstrap 95%)"] = f"{gap:+.1%} [{low:+.1%}, {high:+.1%}]"
+    noise = {e["task"]: e["noise"] for e in entries}
+    for task, methods in summary["tasks"].items():
+        figures[task] = "; ".join(f"{names[m]} {s}/{n} ({s / n:.1%})" for m, (s, n) in methods.items()) + \
+            f"; Vanilla label noise {noise[task]:.0%}"
+    path = results.record(
+        "policy_table1", "Downstream policy: V-CAGE against Vanilla data (the paper's Table 1)",
+        "Does a diffusion policy trained on V-CAGE's verified demonstrations succeed more often on held-out "
+        "scenes than one trained on Vanilla's, task by task and on average?",
+        figures,
+        f"{len(entries)} tasks; per task and method {settings['demos']} demonstrations from one dataset "
+        f"draw (generation seed {settings['seed']}), {settings['train_seeds']} training seeds, "
+        f"{settings['steps']} steps, {settings['eval']} held-out scenes per seed; the gap's interval "
+        "resamples tasks and held-out scenes (training seeds averaged, one dataset draw): it leaves out "
+        "the variance of training seeds and of dataset draws",
+        made=made | {"code_fingerprint": entries[0]["code"], "date": max(e["written"] for e in entries)[:10]})
+    print(f"recorded in {path}")
 
 
 def train_stage(tasks: list[str], args: argparse.Namespace) -> None:

@@ -50,12 +50,19 @@ def command_line() -> str:
 
 
 def record(name: str, title: str, question: str, figures: dict[str, Any], sample: str,
-           folder: Path = RESULTS) -> Path:
-    """Write ``folder/<name>.json`` (replacing the figure it held) and return its path."""
+           folder: Path = RESULTS, made: dict[str, str] | None = None) -> Path:
+    """Write ``folder/<name>.json`` (replacing the figure it held) and return its path.
+
+    ``made`` replaces provenance fields where this process only reports figures another run made
+    (a ledger assembled over sessions): its ``commit`` (a full hash, ``+patched`` with a ``note``
+    saying what was applied) and ``date`` are then that run's, and the machine is not recorded
+    unless given."""
+    provenance = {"command": command_line(), "commit": code()["commit"],
+                  "date": datetime.date.today().isoformat(), "machine": machine()}
+    if made is not None:
+        provenance = {"command": provenance["command"], "machine": "not recorded by the run"} | made
     data = {"name": name, "title": title, "question": question,
-            "figures": {str(k): v for k, v in figures.items()}, "sample": sample,
-            "provenance": {"command": command_line(), "commit": code()["commit"],
-                           "date": datetime.date.today().isoformat(), "machine": machine()}}
+            "figures": {str(k): v for k, v in figures.items()}, "sample": sample, "provenance": provenance}
     folder.mkdir(parents=True, exist_ok=True)
     path = folder / f"{name}.json"
     tmp = path.with_suffix(".json.tmp")

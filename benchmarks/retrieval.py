@@ -24,6 +24,7 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
+import results
 from vcage.assets.catalog import CATALOG
 from vcage.synthesis.retrieval import Retriever
 
@@ -65,6 +66,8 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--data", type=Path, default=DATA)
     parser.add_argument("--verbose", action="store_true", help="list every miss of both halves")
+    parser.add_argument("--record", action="store_true", help="write the test half's figures to "
+                        "docs/results/retrieval.json (the results page)")
     args = parser.parse_args()
     data = json.loads(args.data.read_text())
     queries: dict[str, list[str]] = data["queries"]
@@ -100,6 +103,21 @@ def main() -> None:
         if name == "test" or args.verbose:
             for query, want, got in s.misses:
                 print(f"  {name} miss: {query!r} -> {got} (want {want})")
+    if args.record:
+        no_match = sum(not r.found for _, r in fresh)
+        path = results.record(
+            "retrieval", "Retrieval of catalog types from paraphrases",
+            "Given a phrase naming one object, does the offline retriever answer the catalog type meant "
+            "(test half, types whose queries no ranking rule was tuned on), and 'no match' for an object "
+            "the catalog lacks (fresh negatives, never tuned on)?",
+            {"Recall@1 (test half)": f"{test.r1:.3f}", "Recall@5 (test half)": f"{test.r5:.3f}",
+             "MRR (test half)": f"{test.mrr:.3f}",
+             "fresh negatives answered 'no match'": f"{no_match}/{len(fresh)}",
+             "Recall@1 / Recall@5 (tuning half)": f"{halves['tune'].r1:.3f} / {halves['tune'].r5:.3f}"},
+            f"test half: {test.queries} queries for {test.types} types; tuning half: "
+            f"{halves['tune'].queries} queries for {halves['tune'].types} types; {len(fresh)} fresh "
+            f"negatives; catalog of {len(CATALOG)} types")
+        print(f"recorded in {path}")
 
 
 if __name__ == "__main__":

@@ -81,7 +81,8 @@ def results_page(folder: Path = RESULTS) -> str:
         prov = r["provenance"]
         out.extend(["", f"Sample: {_cell(r['sample'])}", "",
                     f"Printed by `{prov['command']}` at commit `{prov['commit']}` on {prov['date']} "
-                    f"({_cell(prov['machine'])}); data: `docs/results/{r['name']}.json`.", ""])
+                    f"({_cell(prov['machine'])}); data: `docs/results/{r['name']}.json`."
+                    + (f" The commit as run: {_cell(prov['note'])}." if prov.get("note") else ""), ""])
     if not out:
         out.append("No benchmark has written a result yet.")
     return "\n".join(out)

@@ -80,7 +80,8 @@ def test_out_of_range_recovery_settings_are_refused(fields: dict[str, object], m
         GenerateConfig.from_dict({"recovery": fields})
 
 
-def test_a_recovery_dataset_stores_its_settings_and_the_same_seed_gives_the_same_episode(tmp_path: Path) -> None:
+def test_a_recovery_dataset_stores_its_settings_and_the_same_seed_gives_the_same_episode(
+        tmp_path: Path) -> None:
     cfg = replace(GenerateConfig(seed=3),
                   recovery=RecoveryConfig(fraction=0.5, joint_noise=0.05, start_noise=0.05))
     for name in ("a", "b"):

@@ -26,8 +26,8 @@ import docs_hooks  # noqa: E402, I001 - from scripts/ and benchmarks/, put on th
 import results  # noqa: E402
 
 MKDOCS = Path(sys.executable).parent / "mkdocs"
-# what the docs say now (the benchmarks journal keeps each command as it ran then)
-DOCS = [ROOT / "README.md", *sorted(p for p in (ROOT / "docs").glob("*.md") if p.name != "BENCHMARKS.md"),
+# what the docs say now (the journal, docs/journal/, keeps each command as it ran then)
+DOCS = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md")),
         *sorted((ROOT / "docs" / "guides").glob("*.md"))]
 
 
@@ -96,7 +96,8 @@ def test_every_result_names_its_command_commit_date_and_sample(tmp_path: Path) -
         prov = stored["provenance"]
         assert stored["figures"] and stored["sample"], stored["name"]
         assert prov["command"].startswith(("LP_NUM_THREADS", ".venv/bin/python benchmarks/")), stored["name"]
-        assert re.fullmatch(r"[0-9a-f]{40}(\+dirty)?", prov["commit"]), stored["name"]
+        assert re.fullmatch(r"[0-9a-f]{40}(\+dirty|\+patched)?", prov["commit"]), stored["name"]
+        assert not prov["commit"].endswith("+patched") or prov.get("note"), stored["name"]  # says what
         assert re.fullmatch(r"\d{4}-\d\d-\d\d", prov["date"]) and prov["machine"], stored["name"]
 
 

@@ -1,7 +1,7 @@
 """The pieces of the CUDA-graphed training step that run without a GPU.
 
 The graph itself needs CUDA, which CI has not: `benchmarks/train_step_gpu.py` measures it on a GPU
-(steps per second, and how far its weights drift from the eager step's; `docs/BENCHMARKS.md`). What
+(steps per second, and how far its weights drift from the eager step's; `docs/journal/benchmarks.md`). What
 it relies on is checked here: the loss's random inputs drawn apart from the loss give the same loss
 as before, the EMA's in-memory decay averages as the numeric one does, checkpoints store learning
 rates as numbers, and asking for a graph without CUDA is refused before anything is written.

@@ -54,7 +54,7 @@ def train_cmd(
         device: str = typer.Option("cpu", help="cpu, or cuda when a GPU is present"),
         cuda_graph: bool = typer.Option(False, help="on cuda: capture the training step as a CUDA graph "
                                         "and replay it (one run on an H200 at batch 256: 20 steps/s "
-                                        "eager, 131 graphed; see docs/BENCHMARKS.md)"),
+                                        "eager, 131 graphed; see docs/journal/benchmarks.md)"),
         threads: int = typer.Option(None, min=1, help="torch CPU threads (default: torch's choice)")) -> None:
     """Train a policy on DATASET: deterministic on the CPU given --seed, resumable with --resume."""
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn, TimeRemainingColumn
