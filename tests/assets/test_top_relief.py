@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from vcage.assets.catalog import CATALOG
-from vcage.critics.image import _relief
+from vcage.critics.image.measure import _relief
 from vcage.scene.compose import compose
 from vcage.scene.spec import ObjectSpec as O
 from vcage.scene.spec import SceneSpec

@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 
 from vcage.assets.catalog import CATALOG
-from vcage.critics.image import FINGER_CONTACT, HAND_TOP, PRESS_SHARE, _heights
+from vcage.critics.image.measure import _heights
+from vcage.critics.image.thresholds import FINGER_CONTACT, HAND_TOP, PRESS_SHARE
 from vcage.pipeline.verifier import render_views
 from vcage.scene.compose import compose
 from vcage.scene.spec import ObjectSpec, SceneSpec

@@ -20,7 +20,9 @@ import pytest
 
 from critics.recipes import FAILURES, SCENARIOS, faulted, observed, planned, vanilla
 from vcage.critics.base import Verdict
-from vcage.critics.image import ROBOT, ImageCritic, _peak
+from vcage.critics.image import ImageCritic
+from vcage.critics.image.measure import _peak
+from vcage.critics.image.thresholds import ROBOT
 from vcage.critics.masks import touch
 
 CRITIC = ImageCritic()

@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 
 from vcage.critics.base import Observation, View
-from vcage.critics.image import TURNS, ImageCritic
+from vcage.critics.image import ImageCritic
+from vcage.critics.image.thresholds import TURNS
 from vcage.critics.masks import best_move, inward, moved
 from vcage.pipeline.verifier import render_views
 from vcage.planning.goals import put_at, put_on
