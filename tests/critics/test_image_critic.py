@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import json
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -274,3 +277,21 @@ def test_inward_measures_a_centre_from_the_outline_of_a_region() -> None:
     outside = np.zeros_like(region)
     outside[8:13, 40:45] = True  # centre (10, 42): 10 rows above it
     assert inward(outside, region) == pytest.approx(-10.0, abs=1.0)
+
+
+def test_the_critics_version_changes_with_any_rule_and_its_thresholds_are_recorded(tmp_path: Path) -> None:
+    from vcage.critics import image
+    from vcage.critics.image import thresholds
+
+    files = image.rule_files()
+    package = {p.name for p in Path(image.__file__).parent.glob("*.py")}
+    assert package <= {p.name for p in files} and "masks.py" in {p.name for p in files}
+    assert ImageCritic().version() == f"image@{image.rules_digest()}"
+    changed = tmp_path / "thresholds.py"
+    changed.write_text(Path(thresholds.__file__).read_text().replace("NEAR = 0.1", "NEAR = 0.12"))
+    assert changed.read_text() != Path(thresholds.__file__).read_text()
+    swapped = [changed if p.name == "thresholds.py" else p for p in files]
+    assert image.rules_digest(swapped) != image.rules_digest()
+    rules = ImageCritic().rules()
+    assert rules["NEAR"] == thresholds.NEAR and rules["BUTTON_PX"] == list(thresholds.BUTTON_PX)
+    assert json.loads(json.dumps(rules)) == rules  # stored as JSON in the runs log

@@ -338,3 +338,9 @@ def test_answer_parsing_and_config_checks() -> None:
         CriticConfig("vlm", votes=0)
     with pytest.raises(ConfigError):
         CriticConfig("vlm", rule="some")
+
+
+def test_the_vlm_critics_version_names_its_model_and_its_instructions(server: FakeOpenAI) -> None:
+    one, three = _critic(server), _critic(server, votes=3)
+    assert one.version().startswith("vlm:fake-vlm@") and one.version() != three.version()
+    assert one.rules() == {}

@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 
 from vcage.config import RenderConfig
+from vcage.critics.image import ImageCritic
 from vcage.data import DatasetReader
 from vcage.data.layout import ATTEMPTS_LOG, RUNS_LOG, VCAGE_PATH
 from vcage.errors import ConfigError, DatasetError, PlanningError, RegistryError, SceneError
@@ -41,6 +42,10 @@ def test_generate_writes_a_verified_dataset(tmp_path: Path) -> None:
     extras = ep.extras
     assert extras["oracle_success"] and extras["plan"]["subtasks"][1]["skill"] == "press"
     assert [s["verdict"]["accept"] for s in extras["subtasks"]] == [True, True]
+    # which rules judged: the critic's version on every verdict, its thresholds in the run's log line
+    version = ImageCritic().version()
+    assert version.startswith("image@")
+    assert [s["verdict"]["critic"] for s in extras["subtasks"]] == [version] * 2
     bounds = [s["frames"] for s in extras["subtasks"]]
     assert bounds[0][0] == 0 and bounds[0][1] <= bounds[1][0] and bounds[1][1] <= ep.length
     assert ep.arrays["states"].shape[0] == ep.length
@@ -55,6 +60,8 @@ def test_generate_writes_a_verified_dataset(tmp_path: Path) -> None:
     # and the code: the commit, the package's digest and the lock file's hash, in the run and the episode
     assert stats["software"] == extras["software"] == software()
     assert {"commit", "source", "lock"} <= set(extras["software"])
+    assert stats["critic"] == {"version": version, "rules": ImageCritic().rules()}
+    assert stats["critic"]["rules"]["NEAR"] == 0.1 and len(stats["critic"]["rules"]) > 40
     report = audit(out)
     assert report.accepted == 1 and report.agreement == 1.0 and report.judged_subtasks == 2
 

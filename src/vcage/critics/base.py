@@ -71,6 +71,16 @@ class Critic(ABC):
         answers); raises :class:`~vcage.errors.BackendUnavailableError` if not. The default has
         nothing to check."""
 
+    def version(self) -> str:
+        """What judged: the critic and the version of its rules, recorded with every verdict, so that
+        episodes judged under different rules can be told apart (the default: the critic's name)."""
+        return self.name
+
+    def rules(self) -> dict[str, Any]:
+        """The numbers the critic's rules compare with (recorded once per generation run); none by
+        default."""
+        return {}
+
 
 class Recorder(Critic):
     """Accepts every subtask and keeps what it was shown, in order (``seen``): the rollout goes on

@@ -28,6 +28,7 @@ fails at once until the backend is ``reset()``.
 
 from __future__ import annotations
 
+import hashlib
 import json
 import re
 from typing import Any
@@ -66,6 +67,11 @@ class VLMCritic(Critic):
     def __init__(self, backend: ChatBackend, config: CriticConfig | None = None) -> None:
         self.backend = backend
         self.config = config or CriticConfig("vlm")
+
+    def version(self) -> str:
+        """The model and a digest of the instructions it is given (the system prompt) and its voting."""
+        text = f"{SYSTEM}\0{self.config.votes}\0{self.config.rule}"
+        return f"vlm:{self.backend.config.model}@{hashlib.sha256(text.encode()).hexdigest()[:12]}"
 
     def preflight(self) -> None:
         """One cheap request to the model endpoint; raises ``BackendUnavailableError`` if it fails

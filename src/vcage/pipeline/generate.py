@@ -141,6 +141,8 @@ def generate(instruction: str, episodes: int, out: Path | str, cfg: GenerateConf
             if writer.num_episodes:
                 entry = {"instruction": plan.instruction, **funnel.to_dict(), "ended": ended,
                          "software": software()}
+                if critic is not None:  # which rules judged this run's episodes
+                    entry["critic"] = {"version": critic.version(), "rules": critic.rules()}
                 try:
                     attempt_log.append(out / RUNS_LOG, [entry])
                 except OSError:  # e.g. the disk that ended the run is still full: its error says so

@@ -65,7 +65,7 @@ class Verifier:
         self.timing.critic_judge += time.perf_counter() - t1
         if not verdict.accept:
             self.rejected_views = {"before": obs.before, "during": obs.during, "after": obs.after}
-        return verdict.to_dict()
+        return {**verdict.to_dict(), "critic": self.critic.version()}
 
     def _deepest(self, outcome: Outcome) -> dict[str, View]:
         """Views of the recorded frame where the hand was lowest during the subtask."""

@@ -82,9 +82,15 @@ few millimetres, about one pixel of the front view) looks like a press.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+import functools
+import hashlib
+from collections.abc import Callable, Sequence
+from pathlib import Path
+from typing import Any
 
+from vcage.critics import masks
 from vcage.critics.base import CRITICS, Critic, CriticConfig, Observation, Verdict
+from vcage.critics.image import thresholds
 from vcage.critics.image.drawers import _closed, _opened
 from vcage.critics.image.pose import _facing, _hanging, _lifted, _near, _on_table, _side, _upright
 from vcage.critics.image.press import _pressed, _released
@@ -92,8 +98,29 @@ from vcage.critics.image.support import _inside, _on, _stacked
 from vcage.registry import Registry
 
 
+def rule_files() -> list[Path]:
+    """The files the image critic's verdicts depend on: this package (every check and threshold) and
+    the mask operations it uses."""
+    return sorted([*Path(__file__).parent.glob("*.py"), Path(masks.__file__)], key=lambda p: p.name)
+
+
+def rules_digest(files: Sequence[Path] | None = None) -> str:
+    """A digest of the image critic's rules (``files``, default :func:`rule_files`): any change to a
+    rule or a threshold changes it."""
+    digest = hashlib.sha256()
+    for path in rule_files() if files is None else files:
+        digest.update(path.name.encode() + b"\0" + path.read_bytes())
+    return digest.hexdigest()[:12]
+
+
 class ImageCritic(Critic):
     name = "image"
+
+    def version(self) -> str:
+        return f"image@{_DIGEST()}"
+
+    def rules(self) -> dict[str, Any]:
+        return thresholds.values()
 
     def judge(self, obs: Observation) -> Verdict:
         checks: dict[str, bool] = {}
@@ -124,3 +151,6 @@ for _name, _check in _checks.items():
 @CRITICS.register("image")
 def _image(config: CriticConfig) -> Critic:
     return ImageCritic()
+
+
+_DIGEST = functools.cache(rules_digest)

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from typing import Any
+
 ROBOT = -2
 BARE = -1  # what is neither an object nor the robot (the table, the floor) in a segmentation
 TOP, FRONT = "top", "front"
@@ -148,3 +150,16 @@ OPEN_MARGIN = 0.01
 IN_DRAWER = 0.9
 TOP_BAND_BODY = 0.006
 FLOOR_TOL = 0.005  # metres an object's top may lie below its least height above a drawer's floor
+
+
+def values() -> dict[str, Any]:
+    """Every threshold of this module by name, as JSON values (tuples as lists)."""
+    def plain(value: Any) -> Any:
+        if isinstance(value, tuple | list):
+            return [plain(v) for v in value]
+        if isinstance(value, dict):
+            return {str(k): plain(v) for k, v in value.items()}
+        return value
+
+    return {name: plain(value) for name, value in globals().items()
+            if name.isupper() and isinstance(value, int | float | str | tuple | dict)}
