@@ -5,6 +5,7 @@ never a success figure)."""
 from __future__ import annotations
 
 import json
+import math
 from pathlib import Path
 
 import pytest
@@ -71,6 +72,24 @@ def test_sizes_are_set_from_the_cli_and_an_exported_copy_evaluates(generated: Pa
     still = RUN.invoke(app, ["train", str(generated), "--out", str(tmp_path / "other"), "--obs-stride", "0"])
     assert still.exit_code == 2 and "--obs-stride" in flat(still.output)
     assert not (tmp_path / "other").exists()
+
+
+def test_the_budget_can_be_given_in_passes_over_the_data(generated: Path, tmp_path: Path) -> None:
+    from vcage.data import DatasetReader
+
+    frames = DatasetReader(generated, videos=False).total_frames
+    out = tmp_path / "run"
+    result = RUN.invoke(app, ["train", str(generated), "--out", str(out), "--epochs", "0.05", "--batch-size",
+                              "8", "--down-dims", "16,32", "--threads", "1"])
+    assert result.exit_code == 0, result.output
+    assert load_checkpoint(out)["step"] == math.ceil(0.05 * frames / 8) > 1
+    assert "passes over the data" in flat(result.output)
+    both = RUN.invoke(app, ["train", str(generated), "--out", str(tmp_path / "b"), "--epochs", "1",
+                            "--steps", "5"])
+    assert both.exit_code == 2 and "give one" in flat(both.output)
+    none = RUN.invoke(app, ["train", str(generated), "--out", str(tmp_path / "b"), "--epochs", "0"])
+    assert none.exit_code == 2 and "positive number of passes" in flat(none.output)
+    assert not (tmp_path / "b").exists()
 
 
 def test_bad_input_exits_2_with_the_reason(generated: Path, tmp_path: Path) -> None:

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -20,6 +22,8 @@ def train_cmd(
         out: Path = typer.Option(..., help="run directory: checkpoints go to OUT/checkpoints/"),
         policy: str = typer.Option(None, help="diffusion (default) or mlp"),
         steps: int = typer.Option(None, help="optimiser steps in all (default 15000)"),
+        epochs: float = typer.Option(None, help="the budget as passes over the data instead of --steps: "
+                                     "steps = ceil(EPOCHS x frames / batch size)"),
         batch_size: int = typer.Option(None, help="samples per step (default 64)"),
         lr: float = typer.Option(None, help="peak learning rate (default 1e-3)"),
         seed: int = typer.Option(None, help="seed of the weights, batches and noise (default 0)"),
@@ -59,6 +63,7 @@ def train_cmd(
     """Train a policy on DATASET: deterministic on the CPU given --seed, resumable with --resume."""
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn, TimeRemainingColumn
 
+    from vcage.data import DatasetReader
     from vcage.policy.config import TrainConfig, split_keys
     from vcage.policy.train import stored_config, train
 
@@ -78,6 +83,13 @@ def train_cmd(
                               f"{down_dims!r}") from None
         merged["diffusion"] = {**merged.get("diffusion", {}), "down_dims": dims}
     config = TrainConfig.from_dict(merged)
+    frames = DatasetReader(dataset, videos=False).total_frames
+    if epochs is not None:
+        if steps is not None:
+            raise ConfigError("--steps and --epochs both set the budget: give one")
+        if not epochs > 0:
+            raise ConfigError(f"--epochs must be a positive number of passes over the data, got {epochs}")
+        config = replace(config, steps=max(1, math.ceil(epochs * frames / config.batch_size)))
     bar = Progress(TextColumn("{task.description}"), BarColumn(), TextColumn("{task.completed}/{task.total}"),
                    TimeElapsedColumn(), TimeRemainingColumn(), console=console)
     job = bar.add_task(f"training {config.policy}", total=config.steps)
@@ -100,6 +112,8 @@ def train_cmd(
     table.add_column("value", justify="right")
     table.add_row("steps", f"{summary.start_step} -> {summary.steps}" if summary.start_step
                   else str(summary.steps))
+    table.add_row("passes over the data", f"{summary.steps * config.batch_size / max(frames, 1):.1f} "
+                  f"({frames:,} frames, batch {config.batch_size})")
     table.add_row("final loss (mean of last 50 steps)", f"{summary.final_loss:.5f}")
     table.add_row("samples/s", f"{summary.samples_per_second:,.0f}")
     table.add_row("training time", f"{summary.seconds:.1f} s")
