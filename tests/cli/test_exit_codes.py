@@ -144,8 +144,11 @@ def test_ctrl_c_says_what_the_dataset_holds_and_logs_the_run(tmp_path: Path) -> 
 
     out = tmp_path / "ds"
     args = ["generate", "press the bell", "--episodes", "50", "--out", str(out), "--critic", "oracle", *SMALL]
+    # as at a terminal, where Ctrl-C reaches the program: a suite started as a background job without
+    # job control inherits SIGINT ignored, and the child would never see the signal
     run = subprocess.Popen([sys.executable, "-m", "vcage.cli", *args], stdout=subprocess.PIPE,
-                           stderr=subprocess.STDOUT, text=True)
+                           stderr=subprocess.STDOUT, text=True,
+                           preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     deadline = time.monotonic() + 120
     while time.monotonic() < deadline and run.poll() is None:
         try:
