@@ -153,3 +153,24 @@ def test_training_scenes_need_a_dataset_that_stores_its_seeds(tmp_path: Path) ->
                             "--batch-size", "8", "--threads", "1"]).exit_code == 0
     result = RUN.invoke(app, ["evaluate", str(out), "--episodes", "1", "--training-scenes"])
     assert result.exit_code == 2 and "does not store its episodes' scene seeds" in flat(result.output)
+
+
+@pytest.mark.slow
+def test_evaluate_with_temporal_ensembling_records_it_and_refuses_a_period_past_the_chunk(
+        generated: Path, tmp_path: Path) -> None:
+    out, report = tmp_path / "run", tmp_path / "eval.json"
+    trained = RUN.invoke(app, ["train", str(generated), "--policy", "mlp", "--out", str(out), "--steps", "2",
+                               "--batch-size", "8", "--threads", "1"])
+    assert trained.exit_code == 0, trained.output
+    base = ["evaluate", str(out), "--episodes", "2", "--max-steps", "6", "--batch", "2"]
+    result = RUN.invoke(app, [*base, "--ensemble-every", "2", "--ensemble-decay", "0.1",
+                              "--json", str(report)])
+    assert result.exit_code == 0, result.output
+    assert "a chunk every 2 steps, decay 0.1" in flat(result.output)
+    record = json.loads(report.read_text())
+    assert record["ensemble"] == {"every": 2, "decay": 0.1} and len(record["per_episode"]) == 2
+    plain = RUN.invoke(app, [*base, "--json", str(report)])
+    assert plain.exit_code == 0 and json.loads(report.read_text())["ensemble"] is None
+    # a chunk runs 15 steps from the current frame
+    refused = RUN.invoke(app, [*base, "--ensemble-every", "16"])
+    assert refused.exit_code == 2 and "choose every <= 15" in flat(refused.output)

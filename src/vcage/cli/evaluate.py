@@ -52,6 +52,11 @@ def evaluate_cmd(
                                          help="roll out on the scene seeds in this JSON file (a list, or the "
                                          "experiment's eval/TASK.json: its 'solved' held-out scenes), "
                                          "episode k on the k-th; --episodes at most their number"),
+        ensemble_every: int = typer.Option(0, min=0, help="temporal ensembling (ACT): predict a chunk every "
+                                           "N steps and act on the weighted mean of the chunks covering "
+                                           "each step (0: execute n_action_steps of each chunk)"),
+        ensemble_decay: float = typer.Option(0.01, min=0.0, help="the ensemble's weight exp(-decay * i) of "
+                                             "the i-th newer prediction (0: plain mean)"),
         json_out: Path = typer.Option(None, "--json",
                                       help="also write the results to this JSON file")) -> None:
     """Roll out CHECKPOINT for --episodes episodes: success rate (Wilson 95% interval), progress per
@@ -60,6 +65,7 @@ def evaluate_cmd(
 
     from vcage.data import DatasetReader
     from vcage.policy.checkpoint import load_checkpoint
+    from vcage.policy.ensemble import TemporalEnsemble
     from vcage.policy.evaluate import evaluate
     from vcage.policy.evaluate import training_scenes as scenes_of
 
@@ -70,6 +76,7 @@ def evaluate_cmd(
         raise DatasetError(f"{env} stores no vcage configuration (meta/vcage.json); choose a vcage dataset")
     if training_scenes and scenes_file is not None:
         raise ConfigError("--training-scenes and --scenes choose the scenes two ways: give one")
+    ensemble = TemporalEnsemble(ensemble_every, ensemble_decay) if ensemble_every else None
     scenes = scenes_of(load_checkpoint(checkpoint), episodes) if training_scenes else None
     if scenes_file is not None:
         scenes = read_scenes(scenes_file)
@@ -92,7 +99,7 @@ def evaluate_cmd(
     try:
         result = evaluate(checkpoint, episodes, seed=seed, max_steps=max_steps, env_config=env_config,
                           device=device, threads=threads, progress=update, workers=workers, scenes=scenes,
-                          batch=batch)
+                          batch=batch, ensemble=ensemble)
     finally:
         if bar.live.is_started:
             bar.stop()
@@ -111,6 +118,9 @@ def evaluate_cmd(
     table.add_row("rollouts/minute", f"{result.rollouts_per_minute:.2f}")
     table.add_row("scenes", "training (the dataset's own)" if training_scenes else
                   f"{scenes_file} ({len(scenes or [])} seeds)" if scenes_file is not None else "held-out")
+    if ensemble is not None:
+        table.add_row("temporal ensembling",
+                      f"a chunk every {ensemble.every} steps, decay {ensemble.decay:g}")
     table.add_row("seed", str(seed))
     console.print(table)
     if json_out is not None:

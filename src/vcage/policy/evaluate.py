@@ -33,6 +33,7 @@ from vcage.policy.checkpoint import load_checkpoint
 from vcage.policy.config import ACTION
 from vcage.policy.dataset import FeatureSpec
 from vcage.policy.devices import torch_device
+from vcage.policy.ensemble import TemporalEnsemble
 from vcage.policy.errors import EnvironmentMismatchError, PolicyError
 from vcage.policy.inference import PolicyRunner, act_together
 from vcage.policy.metrics import subtask_reached, wilson_interval
@@ -60,6 +61,7 @@ class Evaluation:
     episodes: tuple[EpisodeResult, ...]
     seconds: float
     subtask_names: tuple[str, ...] = ()  # the plan's subtask descriptions, when the config has a plan
+    ensemble: TemporalEnsemble | None = None  # how chunks became actions (None: n_action_steps of each)
 
     @property
     def successes(self) -> int:
@@ -98,6 +100,7 @@ class Evaluation:
                 "successes": self.successes, "success_rate": self.success_rate, "unstable": self.unstable,
                 "wilson95": [low, high], "subtask_progress": self.subtask_progress,
                 "subtask_names": list(self.subtask_names), "mean_progress": self.mean_progress,
+                "ensemble": self.ensemble.to_dict() if self.ensemble is not None else None,
                 "seconds": self.seconds, "rollouts_per_minute": self.rollouts_per_minute,
                 "per_episode": [asdict(e) for e in self.episodes]}
 
@@ -265,7 +268,8 @@ def evaluate(checkpoint: str | Path, episodes: int, *, seed: int = 0, max_steps:
              env_config: dict[str, Any] | None = None, device: str = "cpu", threads: int | None = None,
              make_env: EnvFactory | None = None,
              progress: Callable[[int, int, EpisodeResult], None] | None = None,
-             workers: int = 1, scenes: Sequence[int] | None = None, batch: int = 1) -> Evaluation:
+             workers: int = 1, scenes: Sequence[int] | None = None, batch: int = 1,
+             ensemble: TemporalEnsemble | None = None) -> Evaluation:
     """Roll out ``checkpoint`` (a file, or a training run's directory: its latest) for ``episodes``
     episodes of the environment of ``env_config`` (default: the configuration of the dataset it was
     trained on), seeded ``seed``; ``threads`` caps torch's CPU threads for the duration.
@@ -280,7 +284,9 @@ def evaluate(checkpoint: str | Path, episodes: int, *, seed: int = 0, max_steps:
     ``batch`` > 1 steps the episodes in consecutive blocks of that many together and samples their
     chunks as one batch (:func:`rollout_block`): several times cheaper per episode for a diffusion
     policy on a CPU. Results then depend on ``batch`` (not on ``workers``, which share whole blocks):
-    a batch's arithmetic can differ from one-at-a-time passes in the last bits."""
+    a batch's arithmetic can differ from one-at-a-time passes in the last bits. ``ensemble``: the
+    runners' temporal ensembling (:mod:`vcage.policy.ensemble`; None executes ``n_action_steps`` of
+    each chunk)."""
     if episodes < 1:
         raise PolicyError(f"--episodes must be at least 1, got {episodes}")
     if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
@@ -318,10 +324,10 @@ def evaluate(checkpoint: str | Path, episodes: int, *, seed: int = 0, max_steps:
             env.close()
             results = _parallel(str(payload["path"]), groups, min(workers, len(groups)), factory, config,
                                 seed=seed, max_steps=max_steps, device=device, threads=threads or 1,
-                                progress=progress)
+                                progress=progress, ensemble=ensemble)
         elif batch > 1:
             blocks_here = Blocks(payload, factory, config, seed=seed, max_steps=max_steps, device=device,
-                                 envs=[env])
+                                 envs=[env], ensemble=ensemble)
             results = []
             try:
                 for group in groups:
@@ -332,7 +338,7 @@ def evaluate(checkpoint: str | Path, episodes: int, *, seed: int = 0, max_steps:
             finally:
                 blocks_here.close(keep=1)  # the first environment is ``env``, closed below
         else:
-            runner = PolicyRunner(payload, device=device, seed=seed)
+            runner = PolicyRunner(payload, device=device, seed=seed, ensemble=ensemble)
             results = []
             for k in range(episodes):
                 if direct:  # every episode restarts from the seed: k depends on nothing before it
@@ -345,7 +351,7 @@ def evaluate(checkpoint: str | Path, episodes: int, *, seed: int = 0, max_steps:
     finally:
         env.close()
         torch.set_num_threads(old_threads)
-    return Evaluation(str(payload["path"]), seed, tuple(results), seconds, subtask_names(config))
+    return Evaluation(str(payload["path"]), seed, tuple(results), seconds, subtask_names(config), ensemble)
 
 
 # -- parallel rollouts: one environment and one policy per worker process ---------------------------
@@ -357,15 +363,17 @@ class Blocks:
     far, made when a block first needs them and kept for the next ones."""
 
     def __init__(self, payload: Mapping[str, Any], factory: EnvFactory, config: dict[str, Any], *, seed: int,
-                 max_steps: int | None, device: str, envs: Sequence[gym.Env] = ()) -> None:
-        self.payload, self.factory, self.config = payload, factory, config
+                 max_steps: int | None, device: str, envs: Sequence[gym.Env] = (),
+                 ensemble: TemporalEnsemble | None = None) -> None:
+        self.payload, self.factory, self.config, self.ensemble = payload, factory, config, ensemble
         self.seed, self.max_steps, self.device = seed, max_steps, device
         self.envs: list[gym.Env] = list(envs)
         self.runners: list[PolicyRunner] = []
 
     def run(self, group: Sequence[int]) -> list[EpisodeResult]:
         while len(self.runners) < len(group):
-            self.runners.append(PolicyRunner(self.payload, device=self.device, seed=self.seed))
+            self.runners.append(PolicyRunner(self.payload, device=self.device, seed=self.seed,
+                                             ensemble=self.ensemble))
         while len(self.envs) < len(group):
             self.envs.append(self.factory(self.config, seed=self.seed, max_steps=self.max_steps))
         if len(group) == 1:
@@ -379,11 +387,12 @@ class Blocks:
 
 
 def _start_worker(path: str, factory: EnvFactory, config: dict[str, Any], seed: int,
-                  max_steps: int | None, device: str, threads: int, parent: int) -> None:
+                  max_steps: int | None, device: str, threads: int, parent: int,
+                  ensemble: TemporalEnsemble | None) -> None:
     die_with_parent(parent)
     torch.set_num_threads(threads)
     _WORKER["blocks"] = Blocks(load_checkpoint(path), factory, config, seed=seed, max_steps=max_steps,
-                               device=device)
+                               device=device, ensemble=ensemble)
 
 
 def _worker_block(group: list[int]) -> list[tuple[int, EpisodeResult]]:
@@ -393,7 +402,8 @@ def _worker_block(group: list[int]) -> list[tuple[int, EpisodeResult]]:
 
 def _parallel(path: str, groups: list[list[int]], workers: int, factory: EnvFactory, config: dict[str, Any],
               *, seed: int, max_steps: int | None, device: str, threads: int,
-              progress: Callable[[int, int, EpisodeResult], None] | None) -> list[EpisodeResult]:
+              progress: Callable[[int, int, EpisodeResult], None] | None,
+              ensemble: TemporalEnsemble | None = None) -> list[EpisodeResult]:
     """The blocks of episodes ``groups`` over ``workers`` spawned processes, in episode order."""
     import multiprocessing
     from concurrent.futures import ProcessPoolExecutor, as_completed
@@ -403,7 +413,7 @@ def _parallel(path: str, groups: list[list[int]], workers: int, factory: EnvFact
     context = multiprocessing.get_context("spawn")  # no forked MuJoCo, GL or torch state
     with ProcessPoolExecutor(workers, mp_context=context, initializer=_start_worker,
                              initargs=(path, factory, config, seed, max_steps, device, threads,
-                                       os.getpid())) as pool:
+                                       os.getpid(), ensemble)) as pool:
         futures = [pool.submit(_worker_block, group) for group in groups]
         for future in as_completed(futures):
             for k, result in future.result():

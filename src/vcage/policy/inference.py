@@ -4,7 +4,9 @@ The runner keeps the last ``(n_obs_steps - 1) * obs_stride + 1`` observations (t
 repeated after a reset, as training pads the start of an episode), of which the policy reads every
 ``obs_stride``-th back from the current one, and a queue of actions: when the queue is empty it predicts
 a chunk of ``horizon`` actions from the window and queues the ``n_action_steps`` starting at the
-current frame (index ``n_obs_steps - 1`` of the chunk), as Diffusion Policy executes them.
+current frame (index ``n_obs_steps - 1`` of the chunk), as Diffusion Policy executes them. With a
+:class:`~vcage.policy.ensemble.TemporalEnsemble` it predicts a chunk every ``every`` steps instead
+and acts on the weighted mean of the chunks covering the step (ACT's temporal ensembling).
 
 A subtask-conditioned policy also keeps the subtask it is in: before each chunk its classifier
 names the subtask of the window, and the runner moves on to it if it is a later one. It never goes
@@ -25,6 +27,7 @@ import torch
 from vcage.policy.config import TrainConfig
 from vcage.policy.dataset import FeatureSpec
 from vcage.policy.encoding import VectorEncoder
+from vcage.policy.ensemble import ChunkBlend, TemporalEnsemble
 from vcage.policy.errors import PolicyError
 from vcage.policy.models import Policy, make_policy, randn
 from vcage.policy.normalize import Normalizer
@@ -32,9 +35,11 @@ from vcage.policy.normalize import Normalizer
 
 class PolicyRunner:
     """Acts with the EMA weights of a checkpoint (as :func:`vcage.policy.checkpoint.load_checkpoint`
-    returns it); ``seed`` fixes the diffusion sampler's noise."""
+    returns it); ``seed`` fixes the diffusion sampler's noise; ``ensemble`` turns on temporal
+    ensembling of the chunks (None: execute ``n_action_steps`` of each)."""
 
-    def __init__(self, checkpoint: Mapping[str, Any], *, device: str = "cpu", seed: int = 0) -> None:
+    def __init__(self, checkpoint: Mapping[str, Any], *, device: str = "cpu", seed: int = 0,
+                 ensemble: TemporalEnsemble | None = None) -> None:
         self.config = TrainConfig.from_dict(checkpoint["config"])
         self.obs_features = tuple(FeatureSpec.from_dict(f) for f in checkpoint["obs_features"])
         self.action_feature = FeatureSpec.from_dict(checkpoint["action_feature"])
@@ -56,6 +61,8 @@ class PolicyRunner:
         self._window: deque[np.ndarray] = deque(maxlen=self.span)
         self._queue: deque[np.ndarray] = deque()
         self.subtask = 0  # the subtask a subtask-conditioned policy is in (always 0 for others)
+        chunk_length = self.config.horizon - (self.config.n_obs_steps - 1)  # steps from the current frame on
+        self.blend = ChunkBlend(ensemble, chunk_length) if ensemble is not None else None
 
     @property
     def observation_keys(self) -> tuple[str, ...]:
@@ -66,6 +73,8 @@ class PolicyRunner:
         ``seed`` restarts the sampler's noise, so an episode does not depend on the ones before."""
         self._window.clear()
         self._queue.clear()
+        if self.blend is not None:
+            self.blend.clear()
         self.subtask = 0
         if seed is not None:
             self.generator.manual_seed(seed)
@@ -90,23 +99,35 @@ class PolicyRunner:
         """The observation window the policy reads now (n_obs_steps, size), oldest frame first."""
         return np.stack(list(self._window)[::self.config.obs_stride])
 
-    def _queue_chunk(self, chunk: np.ndarray) -> None:
+    def due(self) -> bool:
+        """Whether this step needs a new chunk (its queue is empty, or the ensemble predicts now)."""
+        return self.blend.due() if self.blend is not None else not self._queue
+
+    def _take_chunk(self, chunk: np.ndarray) -> None:
         start = self.config.n_obs_steps - 1
+        if self.blend is not None:  # the whole chunk from the current frame on, still encoded
+            self.blend.add(self.action_norm.unnormalize(chunk[start:]))
+            return
         executed = self.action_norm.unnormalize(chunk[start:start + self.config.n_action_steps])
         self._queue.extend(self.action_encoder.decode(executed))
+
+    def _next_action(self) -> np.ndarray:
+        if self.blend is not None:
+            return self.action_encoder.decode(self.blend.next().astype(np.float32))
+        return self._queue.popleft()
 
 
 def act_together(runners: Sequence[PolicyRunner],
                  observations: Sequence[Mapping[str, Any]]) -> list[np.ndarray]:
     """One action for each of ``runners`` (episodes of the same checkpoint) given its observation.
 
-    The runners whose queue is empty sample their chunks as one batch through the first runner's
-    network, each starting from noise drawn from its own generator, so an episode's noise does not
-    depend on the others. One runner alone is :meth:`PolicyRunner.act`; a batch's outputs can
-    differ from one-at-a-time passes in the last bits of the floating-point arithmetic."""
+    The runners due a chunk (:meth:`PolicyRunner.due`) sample their chunks as one batch through the
+    first runner's network, each starting from noise drawn from its own generator, so an episode's
+    noise does not depend on the others. One runner alone is :meth:`PolicyRunner.act`; a batch's
+    outputs can differ from one-at-a-time passes in the last bits of the floating-point arithmetic."""
     for runner, obs in zip(runners, observations, strict=True):
         runner._observe(obs)
-    due = [r for r in runners if not r._queue]
+    due = [r for r in runners if r.due()]
     if due:
         lead = runners[0]
         windows = torch.from_numpy(np.stack([r.window() for r in due])).to(lead.device)
@@ -121,5 +142,5 @@ def act_together(runners: Sequence[PolicyRunner],
             subtask = torch.tensor([r.subtask for r in due], device=lead.device)
         chunks = lead.model.predict_from(windows, noise, subtask).cpu().numpy()
         for runner, chunk in zip(due, chunks, strict=True):
-            runner._queue_chunk(chunk)
-    return [r._queue.popleft() for r in runners]
+            runner._take_chunk(chunk)
+    return [r._next_action() for r in runners]
