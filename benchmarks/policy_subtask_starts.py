@@ -41,8 +41,9 @@ def main() -> None:
     from vcage.pipeline.features import EE_POSE
     from vcage.policy.checkpoint import load_checkpoint
     from vcage.policy.dataset import fingerprint
-    from vcage.policy.evaluate import check_compatible, episode_noise_seed
+    from vcage.policy.evaluate import check_compatible
     from vcage.policy.inference import PolicyRunner
+    from vcage.policy.rollout import episode_noise_seed
 
     torch.set_num_threads(1)
     payload = load_checkpoint(args.checkpoint)

@@ -40,8 +40,8 @@ def main() -> None:
 
     from vcage.pipeline.evaluation import make_env
     from vcage.policy.checkpoint import load_checkpoint
-    from vcage.policy.evaluate import episode_noise_seed
     from vcage.policy.inference import PolicyRunner
+    from vcage.policy.rollout import episode_noise_seed
 
     torch.set_num_threads(1)
     payload = load_checkpoint(args.checkpoint)

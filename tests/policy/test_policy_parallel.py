@@ -16,8 +16,9 @@ from vcage.errors import ConfigError
 from vcage.pipeline.evaluation import eval_seed, make_env
 from vcage.policy.checkpoint import load_checkpoint
 from vcage.policy.errors import PolicyError
-from vcage.policy.evaluate import evaluate, rollout
+from vcage.policy.evaluate import evaluate
 from vcage.policy.inference import PolicyRunner
+from vcage.policy.rollout import rollout
 from vcage.policy.train import train
 
 pytestmark = pytest.mark.slow  # evaluation rollouts in worker processes
@@ -112,7 +113,7 @@ def test_batched_blocks_give_the_same_episodes_from_one_worker_or_two(generated:
 def test_a_block_samples_each_episodes_chunk_from_its_own_noise(generated: Path, diffusion_run: Path) -> None:
     """Stepped beside another episode, an episode's actions are its actions alone (to float32
     rounding of the batched arithmetic), not those of its neighbour's noise."""
-    from vcage.policy.evaluate import rollout_block
+    from vcage.policy.rollout import rollout_block
 
     config = DatasetReader(generated).config
     payload = load_checkpoint(diffusion_run)

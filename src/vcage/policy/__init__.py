@@ -5,8 +5,9 @@ Modules, one concept each: :mod:`~vcage.policy.config` (the run's configuration)
 (``delta_timestamps``-style windows), :mod:`~vcage.policy.normalize`, :mod:`~vcage.policy.sampler`,
 :mod:`~vcage.policy.diffusion` (DDPM/DDIM), :mod:`~vcage.policy.unet`, :mod:`~vcage.policy.models`
 (diffusion and MLP policies), :mod:`~vcage.policy.ema`, :mod:`~vcage.policy.checkpoint`,
-:mod:`~vcage.policy.train`, :mod:`~vcage.policy.inference`, :mod:`~vcage.policy.evaluate`,
-:mod:`~vcage.policy.metrics`, :mod:`~vcage.policy.errors`.
+:mod:`~vcage.policy.train`, :mod:`~vcage.policy.inference`, :mod:`~vcage.policy.ensemble`,
+:mod:`~vcage.policy.rollout`, :mod:`~vcage.policy.evaluate`, :mod:`~vcage.policy.metrics`,
+:mod:`~vcage.policy.errors`.
 
 Importing this package does not import torch; the modules that need it do (``train``,
 ``evaluate``, ``models`` ...), so ``vcage --help`` starts without it.
