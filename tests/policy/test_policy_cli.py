@@ -57,12 +57,13 @@ def test_sizes_are_set_from_the_cli_and_an_exported_copy_evaluates(generated: Pa
     out, moved = tmp_path / "run", tmp_path / "moved.pt"
     result = RUN.invoke(app, ["train", str(generated), "--out", str(out), "--steps", "2", "--batch-size", "4",
                               "--down-dims", "16,32", "--n-obs-steps", "4", "--obs-stride", "3",
-                              "--threads", "1", "--export", str(moved)])
+                              "--threads", "1", "--export", str(moved), "--relative-objects"])
     assert result.exit_code == 0, result.output
     assert "exported for evaluation" in flat(result.output)
     copy = load_checkpoint(moved)
     assert tuple(copy["config"]["diffusion"]["down_dims"]) == (16, 32) and copy["evaluation_only"] is True
     assert copy["config"]["n_obs_steps"] == 4 and copy["config"]["obs_stride"] == 3
+    assert copy["config"]["relative_objects"] is True  # and it evaluates on the offsets of the real scene
     evaluated = RUN.invoke(app, ["evaluate", str(moved), "--episodes", "1", "--max-steps", "8"])
     assert evaluated.exit_code == 0, evaluated.output
     bad = RUN.invoke(app, ["train", str(generated), "--out", str(tmp_path / "other"), "--down-dims", "16,x"])

@@ -13,7 +13,7 @@ from vcage.errors import ConfigError
 from vcage.policy.checkpoint import load_checkpoint
 from vcage.policy.config import TrainConfig
 from vcage.policy.dataset import FeatureSpec, load_training_data
-from vcage.policy.encoding import VectorEncoder, quaternion_starts, rot6d
+from vcage.policy.encoding import VectorEncoder, position_starts, quaternion_starts, rot6d
 from vcage.policy.inference import PolicyRunner
 from vcage.policy.train import train
 
@@ -99,3 +99,49 @@ def test_training_data_carries_the_encoded_observations(dataset: Path) -> None:
     assert raw.obs.shape[1] == 22 and encoded.obs.shape[1] == 26  # two quaternions, 4 -> 6 values each
     encoder = VectorEncoder(raw.obs_features, "rot6d")
     np.testing.assert_allclose(encoded.obs, encoder(raw.obs), rtol=1e-6)
+
+
+def test_object_positions_are_found_by_their_element_names() -> None:
+    assert position_starts(EE_NAMES) == [("", 0)]
+    assert position_starts(FEATURES[2].names) == [("bell.", 0), ("pad.", 7)]
+    assert position_starts(("a.x", "b.y", "a.z")) == [] and position_starts(("px", "py", "pz")) == []
+    assert position_starts(None) == []
+
+
+def test_relative_inputs_append_each_object_position_minus_the_tools() -> None:
+    rng = np.random.default_rng(1)
+    raw = rng.normal(size=(5, 23)).astype(np.float32)
+    plain = VectorEncoder(FEATURES, "rot6d")
+    relative = VectorEncoder(FEATURES, "rot6d", relative=True)
+    assert relative.size == plain.size + 6
+    encoded = relative(raw)
+    np.testing.assert_array_equal(encoded[:, :plain.size], plain(raw))  # the plain inputs come first
+    tool, bell, pad = raw[:, 2:5], raw[:, 9:12], raw[:, 16:19]
+    np.testing.assert_allclose(encoded[:, plain.size:plain.size + 3], bell - tool, atol=1e-6)
+    np.testing.assert_allclose(encoded[:, plain.size + 3:], pad - tool, atol=1e-6)
+    assert not relative.rotation_mask()[plain.size:].any()  # offsets are positions
+    with pytest.raises(ValueError, match="decodes nothing"):
+        relative.decode(encoded)
+
+
+def test_relative_inputs_without_the_tool_or_an_object_are_refused() -> None:
+    with pytest.raises(ConfigError, match="found 0 tool and 2 object positions"):
+        VectorEncoder([FEATURES[0], FEATURES[2]], "rot6d", relative=True)
+    with pytest.raises(ConfigError, match="found 1 tool and 0 object positions"):
+        VectorEncoder(FEATURES[:2], "rot6d", relative=True)
+    with pytest.raises(ConfigError, match="relative_objects must be true or false"):
+        TrainConfig(relative_objects="yes")  # type: ignore[arg-type]
+
+
+def test_a_policy_with_relative_inputs_trains_and_acts_on_the_offsets(dataset: Path, tmp_path: Path) -> None:
+    config = tiny("mlp", steps=2, checkpoint_every=2, relative_objects=True)
+    data = load_training_data(dataset, config)
+    plain = load_training_data(dataset, tiny("mlp", steps=2, checkpoint_every=2))
+    assert data.obs.shape[1] == plain.obs.shape[1] + 3  # one object (the block)
+    runner = PolicyRunner(load_checkpoint(train(dataset, tmp_path / "run", config).checkpoint))
+    assert runner.encoder.relative and runner.encoder.size == data.obs.shape[1]
+    obs = {"observation.state": np.zeros(8, np.float32),
+           "observation.ee_pose": np.array([0.1, 0.2, 0.3, 1, 0, 0, 0], np.float32),
+           "observation.environment_state": np.array([0.5, -0.2, 0.3, 1, 0, 0, 0], np.float32)}
+    np.testing.assert_allclose(runner.observation_vector(obs)[-3:], [0.4, -0.4, 0.0], atol=1e-6)
+    assert runner.act(obs).shape == (8,)

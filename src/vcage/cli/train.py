@@ -51,6 +51,10 @@ def train_cmd(
                                                  help="hierarchical: condition the policy on the plan's "
                                                  "subtask, which a classifier head names from the "
                                                  "observation during evaluation (needs subtask_index)"),
+        relative_objects: bool = typer.Option(None, "--relative-objects/--no-relative-objects",
+                                              help="also observe each object's position minus the tool's "
+                                              "(needs observation.ee_pose and "
+                                              "observation.environment_state)"),
         down_dims: str = typer.Option(None, help="the diffusion U-Net's channels per level, comma-separated "
                                       "(default 32,64,128)"),
         export: Path = typer.Option(None, help="also write the final checkpoint for evaluation only (EMA "
@@ -71,6 +75,7 @@ def train_cmd(
                              "seed": seed, "checkpoint_every": checkpoint_every, "rotations": rotations,
                              "action_key": action, "subtask_conditioned": subtask_conditioned,
                              "n_obs_steps": n_obs_steps, "obs_stride": obs_stride,
+                             "relative_objects": relative_objects,
                              "observation_keys": split_keys(obs) if obs else None}
     given = {k: v for k, v in given.items() if v is not None}
     base = stored_config(out) if resume else None

@@ -129,6 +129,9 @@ class TrainConfig:
     norm_floor: float = 0.01
     rotation_floor: float = 0.05
     rotations: str = "rot6d"  # quaternions read as rotation-matrix columns (see vcage.policy.encoding)
+    # append each observed object's position minus the tool's (vcage.policy.encoding): needs
+    # observation.ee_pose and observation.environment_state among the observations
+    relative_objects: bool = False
     n_obs_steps: int = 2
     # frames between two observed frames: the window reaches (n_obs_steps - 1) * obs_stride frames back,
     # so a few frames can span a whole motion (the way down to a button and the way back up look
@@ -159,6 +162,8 @@ class TrainConfig:
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, int) or value < 1:
                 raise ConfigError(f"{name} must be a positive integer, got {value!r}")
+        if not isinstance(self.relative_objects, bool):
+            raise ConfigError(f"relative_objects must be true or false, got {self.relative_objects!r}")
         if not isinstance(self.subtask_conditioned, bool):
             raise ConfigError(f"subtask_conditioned must be true or false, got {self.subtask_conditioned!r}")
         if isinstance(self.seed, bool) or not isinstance(self.seed, int) or self.seed < 0:

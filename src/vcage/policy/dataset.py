@@ -158,7 +158,7 @@ def load_training_data(root: str | Path, config: TrainConfig) -> TrainingData:
         if config.subtask_conditioned:
             subtask.append(_subtasks(frames[SUBTASK], i, reader.root))
     raw = np.concatenate([np.concatenate(p) for p in obs_parts], axis=1)
-    obs = VectorEncoder(specs, config.rotations)(raw)
+    obs = VectorEncoder(specs, config.rotations, config.relative_objects)(raw)
     action_spec = _spec(reader, config.action_key)
     action = VectorEncoder([action_spec], config.rotations)(np.concatenate(actions))
     info = DatasetInfo(str(reader.root), fingerprint(reader), reader.fps, reader.num_episodes,

@@ -17,6 +17,12 @@ by Gram-Schmidt, the third their cross product, then the quaternion with ``w >= 
 
 Quaternions are found by their element names: four consecutive elements named ``qw, qx, qy, qz``,
 each with the same prefix (``bell.qw`` ... ``bell.qz``) or none.
+
+With ``relative=True`` an observation encoder also appends, for every object position it reads
+(three consecutive elements ``P.x, P.y, P.z``), that position minus the tool's (the elements ``x, y,
+z`` with no prefix, the end effector's pose): the offset from the hand to each object, which a
+network otherwise has to learn to subtract from two absolute inputs (positions in the world frame,
+in metres).
 """
 
 from __future__ import annotations
@@ -31,6 +37,7 @@ from vcage.geometry import mat_to_quat
 
 ROTATIONS = ("rot6d", "quaternion")
 QUATERNION = ("qw", "qx", "qy", "qz")
+POSITION = ("x", "y", "z")
 ROT6D_SIZE = 6
 
 
@@ -60,6 +67,21 @@ def quaternion_starts(names: Sequence[str] | None) -> list[int]:
     return starts
 
 
+def position_starts(names: Sequence[str] | None) -> list[tuple[str, int]]:
+    """(prefix, index) of each run of ``x, y, z`` element names with one common prefix (``""`` for
+    none, else ending in a dot: ``mouse.``)."""
+    if not names:
+        return []
+    found = []
+    for i in range(len(names) - 2):
+        run = zip(names[i:i + 3], POSITION, strict=True)
+        prefixes = {n[:-1] if n.endswith(p) else None for n, p in run}
+        prefix = prefixes.pop() if len(prefixes) == 1 else None
+        if prefix is not None and (prefix == "" or prefix.endswith(".")):
+            found.append((prefix, i))
+    return found
+
+
 def rot6d(quat: np.ndarray) -> np.ndarray:
     """(..., 4) quaternions (w, x, y, z), not necessarily unit, -> (..., 6): the rotation matrix's
     first two columns."""
@@ -85,28 +107,44 @@ def rot6d_to_quat(x: np.ndarray) -> np.ndarray:
 
 class VectorEncoder:
     """Stored vector features (side by side, in order) -> the policy's vector (observation input or
-    action output), and back for actions (:meth:`decode`)."""
+    action output), and back for actions (:meth:`decode`); ``relative``: append the tool-to-object
+    offsets (observations only)."""
 
-    def __init__(self, features: Sequence[Feature], rotations: str) -> None:
+    def __init__(self, features: Sequence[Feature], rotations: str, relative: bool = False) -> None:
         if rotations not in ROTATIONS:
             raise ConfigError(f"unknown rotations {rotations!r}; valid: {', '.join(ROTATIONS)}")
         self.rotations = rotations
         self.raw_size = sum(f.size for f in features)
         starts, offset = [], 0
+        tools: list[int] = []
+        objects: list[int] = []
         for f in features:
             if rotations == "rot6d":
                 starts += [offset + s for s in quaternion_starts(f.names)]
+            for prefix, at in position_starts(f.names):
+                (tools if prefix == "" else objects).append(offset + at)
             offset += f.size
         self.starts = tuple(starts)
+        self.relative = bool(relative)
+        self.tool: int | None = None
+        self.objects: tuple[int, ...] = ()
+        if self.relative:
+            if len(tools) != 1 or not objects:
+                raise ConfigError(
+                    "object-relative inputs need the tool's position (one run of elements x, y, z: "
+                    "observation.ee_pose) and at least one object's (P.x, P.y, P.z: "
+                    f"observation.environment_state) among the observed features; found {len(tools)} "
+                    f"tool and {len(objects)} object positions: observe both, or train without them")
+            self.tool, self.objects = tools[0], tuple(objects)
 
     @property
     def size(self) -> int:
-        return self.raw_size + len(self.starts) * (ROT6D_SIZE - 4)
+        return self.raw_size + len(self.starts) * (ROT6D_SIZE - 4) + 3 * len(self.objects)
 
     def rotation_mask(self) -> np.ndarray:
         """(size,) bool: which values of the encoded vector are rotation-matrix columns (or, with
         ``rotations="quaternion"``, none: a quaternion passes through as four plain values)."""
-        mask, shift = np.zeros(self.size, dtype=bool), 0
+        mask, shift = np.zeros(self.size, dtype=bool), 0  # offsets (at the end) are positions
         for s in self.starts:
             mask[s + shift:s + shift + ROT6D_SIZE] = True
             shift += ROT6D_SIZE - 4
@@ -117,19 +155,23 @@ class VectorEncoder:
         x = np.asarray(raw, dtype=np.float32)
         if x.shape[-1] != self.raw_size:
             raise ValueError(f"expected {self.raw_size} values, got {x.shape[-1]}")
-        if not self.starts:
-            return x
         parts, last = [], 0
         for s in self.starts:
             parts += [x[..., last:s], rot6d(x[..., s:s + 4]).astype(np.float32)]
             last = s + 4
         parts.append(x[..., last:])
-        return np.concatenate(parts, axis=-1)
+        if self.tool is not None:
+            tool = x[..., self.tool:self.tool + 3]
+            parts += [x[..., o:o + 3] - tool for o in self.objects]
+        return np.concatenate(parts, axis=-1) if len(parts) > 1 else x
 
     def decode(self, encoded: np.ndarray) -> np.ndarray:
         """(..., size) policy values -> (..., raw_size) values in the stored form (each rot6d pair of
         columns back to a unit quaternion)."""
         x = np.asarray(encoded, dtype=np.float32)
+        if self.relative:
+            raise ValueError("an encoder with object-relative inputs encodes observations: it decodes "
+                             "nothing")
         if x.shape[-1] != self.size:
             raise ValueError(f"expected {self.size} encoded values, got {x.shape[-1]}")
         if not self.starts:

@@ -46,7 +46,7 @@ class PolicyRunner:
         self.obs_norm = Normalizer.from_dict(checkpoint["normalization"]["obs"])
         self.action_norm = Normalizer.from_dict(checkpoint["normalization"]["action"])
         self.device = torch.device(device)
-        self.encoder = VectorEncoder(self.obs_features, self.config.rotations)
+        self.encoder = VectorEncoder(self.obs_features, self.config.rotations, self.config.relative_objects)
         self.action_encoder = VectorEncoder([self.action_feature], self.config.rotations)
         self.model: Policy = make_policy(self.config, self.encoder.size, self.action_encoder.size,
                                          int(checkpoint.get("subtasks", 0)))

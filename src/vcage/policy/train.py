@@ -223,10 +223,12 @@ def _resume_from(out: Path, config: TrainConfig, resume: bool) -> dict[str, Any]
     return payload
 
 
-def floors(features: Sequence[FeatureSpec], config: TrainConfig) -> np.ndarray:
-    """The smallest normalisation scale of each value the policy reads or writes: ``rotation_floor``
-    for rotation-matrix columns, ``norm_floor`` for the rest (see :mod:`vcage.policy.normalize`)."""
-    mask = VectorEncoder(features, config.rotations).rotation_mask()
+def floors(features: Sequence[FeatureSpec], config: TrainConfig, observations: bool = True) -> np.ndarray:
+    """The smallest normalisation scale of each value the policy reads (``observations``) or writes:
+    ``rotation_floor`` for rotation-matrix columns, ``norm_floor`` for the rest (see
+    :mod:`vcage.policy.normalize`)."""
+    relative = config.relative_objects and observations
+    mask = VectorEncoder(features, config.rotations, relative).rotation_mask()
     return np.where(mask, config.rotation_floor, config.norm_floor)
 
 
@@ -255,7 +257,8 @@ def train(dataset: str | Path, out: str | Path, config: TrainConfig, *, resume: 
     else:
         normalization = {
             "obs": Normalizer.fit(data.obs, config.obs_norm, floors(data.obs_features, config)),
-            "action": Normalizer.fit(data.action, "min_max", floors([data.action_feature], config))}
+            "action": Normalizer.fit(data.action, "min_max",
+                                     floors([data.action_feature], config, observations=False))}
     with deterministic(threads, where):
         if graph and where.type != "cuda":
             raise ConfigError(f"a CUDA graph of the training step needs a CUDA device, not {device!r}")
