@@ -12,6 +12,7 @@ Vec3 = tuple[float, ...]  # (x, y, z)
 HALF_PI = math.pi / 2
 FOUR_SIDES = (0.0, HALF_PI, math.pi, -HALF_PI)  # angles of the four sides of a round object
 RIM_DROP = 0.015  # rim grasps hold the wall this far below its top
+S2 = math.sqrt(0.5)  # cos and sin of 45 degrees: quaternions of quarter turns
 
 
 @dataclass(frozen=True)

@@ -22,6 +22,7 @@ RGBA = tuple[float, ...]  # (r, g, b, a)
 VISUAL: dict[str, Any] = {"contype": 0, "conaffinity": 0}  # geom options for decoration only
 DARK: RGBA = (0.12, 0.12, 0.13, 1.0)  # black plastic parts
 METAL: RGBA = (0.78, 0.78, 0.8, 1.0)  # steel parts
+WHITE: RGBA = (0.95, 0.95, 0.94, 1.0)  # white plastic and paper parts
 X_AXIS_QUAT = (math.sqrt(0.5), 0.0, math.sqrt(0.5), 0.0)  # turns a cylinder's or capsule's axis onto x
 Y_AXIS_QUAT = (math.sqrt(0.5), math.sqrt(0.5), 0.0, 0.0)  # turns a cylinder's or capsule's axis onto y
 

@@ -23,24 +23,14 @@ Every plan has at most ``max_subtasks`` subtasks. A :class:`PlanningError` says 
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass, field
 
 from pydantic import ValidationError
 
 from vcage.assets.catalog import CATALOG
 from vcage.errors import ConfigError, PlanningError
+from vcage.planning.clauses import _is_step, split_clauses
 from vcage.planning.config import MAX_SUBTASKS
-from vcage.planning.goals import (
-    GOALS,
-    Goal,
-    close_drawer,
-    hang,
-    open_drawer,
-    press,
-    put_in,
-    put_on,
-    turn_to_face,
-)
+from vcage.planning.goals import GOALS, Goal
 from vcage.planning.language import Matcher, Scored, bounded, tokens
 from vcage.planning.lexicon import (
     ALIASES,
@@ -49,150 +39,23 @@ from vcage.planning.lexicon import (
     PREPOSITIONS,
     SIZES,
     Mention,
-    ObjectRef,
     determiner_phrases,
     find_mentions,
     listed,
-    parse_phrase,
     uncovered,
     words,
 )
 from vcage.planning.schema import GoalMatch, Plan, PlanObject, Subtask
+from vcage.planning.steps import _clause, _Objects, _words
 
 MATCH_THRESHOLD = 0.34  # lowest paraphrase score accepted as a goal
 # a sentence that reads as explicit steps but does not parse may still *be* a goal's phrasing
 EXACT_MATCH = 0.9
-
-# separators that always end a step; weak ones (commas, "and") only before a verb or an elided step
-_STRONG = re.compile(r"\s*(?:;|[.!?](?:\s+|$)|,?\s*\b(?:and\s+)?then\b,?|,?\s*\b(?:and\s+)?after\s+that\b,?"
-                     r"|,?\s*\bafterwards\b,?)\s*")
-_WEAK = re.compile(r"(\s*,\s*(?:and\s+)?|\s+and\s+)")
-_PREFIX = re.compile(r"^(?:(?:please|kindly|now|first|firstly|next|finally|lastly|also|and|robot)\b,?\s*"
-                     r"|(?:can|could|would|will)\s+you\s+(?:please\s+)?"
-                     r"|i\s+(?:want|need|would\s+like|'?d\s+like)\s+you\s+to\s+)+")
-_PLACE_VERBS = "put|place|move|set|drop|lay|stack|nest|bring|carry"
-_PRESS_VERBS = "press|push|click|ring|hit|tap|silence|flip|toggle|turn on|turn off|switch on|switch off|use"
-_DRAWER_VERBS = "open|pull open|pull out|close|shut"
-_REL = r"on top of|onto|on|into|inside of|inside|in"
-_PLACE = re.compile(rf"^(?:{_PLACE_VERBS})\s+(?P<obj>.+?)\s+(?P<rel>{_REL})\s+(?P<target>.+)$")
-_ELIDED = re.compile(rf"^(?P<obj>.+?)\s+(?P<rel>{_REL})\s+(?P<target>.+)$")  # "..., the cup on the coaster"
-_PRESS = re.compile(rf"^(?P<verb>{_PRESS_VERBS})\s+(?P<obj>.+)$")
-# "close up the office" and "shut down the laptop" are not about a drawer
-_DRAWER = re.compile(rf"^(?P<verb>{_DRAWER_VERBS})\s+(?!(?:up|down|off)\b)(?P<obj>.+)$")
-# "turn the QR code board to face me": a step of its own, read before the press verbs ("turn on ...")
-_FACE = re.compile(r"^(?:turn|rotate)\s+(?P<obj>.+?)\s+(?:a?round\s+)?(?:to\s+face|towards?)\s+"
-                   r"(?:me|us|the\s+robot)$")
-_HANG = re.compile(r"^hang\s+(?P<obj>.+?)\s+(?:up\s+)?(?:on|onto|from)\s+(?P<target>.+)$")
-_COMMAND = re.compile(rf"^(?:{_PLACE_VERBS}|{_PRESS_VERBS}|{_DRAWER_VERBS}|switch|turn|rotate|hang)\b")
-_GERUNDS = {"putting": "put", "placing": "place", "moving": "move", "setting": "set", "dropping": "drop",
-            "laying": "lay", "stacking": "stack", "nesting": "nest", "pressing": "press", "pushing": "push",
-            "ringing": "ring", "hitting": "hit", "tapping": "tap", "silencing": "silence", "flipping": "flip"}
-_ORDER = re.compile(r"^(?P<a>.+?)\s+(?P<when>after|before)\s+(?P<g>[a-z]+ing)\s+(?P<rest>.+)$")
 _NEGATION = re.compile(r"\b(?:not|never|without|except|nor|dont|instead)\b|n't\b")
 # a goal does its fixed number of things: a count in a goal sentence asks for something else
 _COUNT = re.compile(r"\b(?:\d+|two|three|four|five|six|seven|eight|nine|ten|twice|thrice|times|dozen"
                     r"|several|many)\b")
 
-
-@dataclass
-class _Objects:
-    """The plan objects named so far in a sequence."""
-
-    items: list[tuple[ObjectRef, PlanObject]] = field(default_factory=list)
-
-    def resolve(self, ref: ObjectRef, type_: str, clause: str, fresh: bool = False) -> PlanObject:
-        """The plan object ``ref`` names: one already named if it is the same, else a new one
-        (``fresh`` or "the other ...": always a new one)."""
-        same_type = [o for _, o in self.items if o.type == type_]
-        if not (fresh or ref.other):
-            exact = [o for r, o in self.items if o.type == type_ and o.color == ref.colour
-                     and (not ref.sized or r.size == ref.size)]
-            if ref.colour is None and not ref.sized and same_type:
-                exact = same_type  # "the block" again
-            if len(exact) == 1:
-                return exact[0]
-            if len(exact) > 1:
-                raise PlanningError(
-                    f"{bounded(ref.text, 80)} in {bounded(clause, 120)} could be any of "
-                    f"{listed([_words(o) for o in exact])}; name it by its colour")
-        name = f"{ref.colour}_{type_}" if ref.colour else type_
-        if any(o.name == name for _, o in self.items):
-            name = f"{name}{len(same_type) + 1}"
-        obj = PlanObject(name=name, type=type_, color=ref.colour, scale=ref.size)
-        self.items.append((ref, obj))
-        return obj
-
-    def objects(self) -> tuple[PlanObject, ...]:
-        return tuple(o for _, o in self.items)
-
-
-def _words(o: PlanObject) -> str:
-    return f"{o.color + ' ' if o.color else ''}{o.type.replace('_', ' ')}"
-
-
-def _type_in_context(ref: ObjectRef, other: str | None) -> str:
-    """The type ``ref`` names next to an object of type ``other`` (a phone's stand: the phone stand)."""
-    if "phone_stand" in ref.accepts and other == "phone":
-        return "phone_stand"
-    return ref.type
-
-
-def _check_colour(ref: ObjectRef, type_: str) -> None:
-    if ref.colour is not None and ref.colour not in CATALOG.get(type_).colors:
-        raise PlanningError(f"there is no {ref.colour} {type_.replace('_', ' ')}; colours: "
-                            f"{', '.join(sorted(CATALOG.get(type_).colors))}")
-
-
-def _strip(clause: str) -> str:
-    clause = _PREFIX.sub("", clause.strip(" ,.!?")).strip(" ,.!?")
-    return re.sub(r"\s*,?\s*please$", "", clause)
-
-
-def split_clauses(text: str) -> list[str]:
-    """The clauses of ``text``, lower-cased, in execution order."""
-    clauses: list[str] = []
-    for part in _STRONG.split(text.lower()):
-        part = _strip(part)
-        if not part:
-            continue
-        pieces = _WEAK.split(part)  # piece, separator, piece, ...
-        first = _strip(pieces[0])
-        merged = [_elided(first, clauses[-1]) if clauses else first]
-        for sep, raw in zip(pieces[1::2], pieces[2::2], strict=True):
-            piece = _strip(raw)
-            if _COMMAND.match(piece) and merged[-1]:
-                merged.append(piece)
-            elif _elided(piece, merged[-1]) != piece:
-                merged.append(_elided(piece, merged[-1]))
-            else:
-                merged[-1] = f"{merged[-1]}{sep}{raw}"  # a list inside one step: "the red and blue block"
-        for clause in filter(None, merged):
-            m = _ORDER.match(clause)
-            if m and m["g"] in _GERUNDS:  # "press the bell after putting the cup on the coaster"
-                later = f"{_GERUNDS[m['g']]} {m['rest']}"
-                clauses += [later, m["a"]] if m["when"] == "after" else [m["a"], later]
-            else:
-                clauses.append(clause)
-    return clauses
-
-
-def _elided(piece: str, previous: str) -> str:
-    """``piece`` with the verb of ``previous`` if it is a placing step without its verb
-    ("put the remote in the box and the marker in the cup")."""
-    m = _ELIDED.match(piece)
-    if (m and not _COMMAND.match(piece) and _PLACE.match(previous)
-            and find_mentions(words(m["obj"]), all_objects=True)):
-        return f"{previous.split(' ', 1)[0]} {piece}"
-    return piece
-
-
-def _is_step(clause: str) -> bool:
-    """Whether ``clause`` is (or tries to be) an explicit step: a step's shape, or a command verb
-    (opening or closing a drawer among them: "shut everything down" is not a step) and a catalog
-    object."""
-    if _PLACE.match(clause) or _PRESS.match(clause):
-        return True
-    return bool(_COMMAND.match(clause) and find_mentions(words(clause)))
 
 
 class OfflinePlanner:
@@ -256,7 +119,7 @@ class OfflinePlanner:
         subtasks: list[Subtask] = []
         for clause in clauses:
             try:
-                subtasks.append(self._clause(clause, objects))
+                subtasks.append(_clause(clause, objects))
             except PlanningError as exc:
                 raise PlanningError(f"{exc}{self._understood(clauses, subtasks)}") from None
         if not subtasks:
@@ -272,85 +135,6 @@ class OfflinePlanner:
                                 f"but these named objects would be missing: {listed(missing)}; "
                                 f"{self.capabilities()}")
         return self._capped(plan)
-
-    def _clause(self, clause: str, objects: _Objects) -> Subtask:
-        m = _PLACE.match(clause)
-        if m:
-            o_ref, t_ref = parse_phrase(m["obj"], clause), parse_phrase(m["target"], clause)
-            o_type = _type_in_context(o_ref, None)
-            t_type = _type_in_context(t_ref, o_type)
-            _check_colour(o_ref, o_type)
-            _check_colour(t_ref, t_type)
-            o = objects.resolve(o_ref, o_type, clause)
-            t = objects.resolve(t_ref, t_type, clause)
-            if t.name == o.name:  # "put the bowl in the other bowl"
-                t = objects.resolve(t_ref, t_type, clause, fresh=True)
-            places = CATALOG.get(t.type).placements
-            if not places:
-                raise PlanningError(f"nothing can be put on or in the {t.type.replace('_', ' ')} "
-                                    f"(in {bounded(clause)}); objects that hold others: "
-                                    f"{', '.join(CATALOG.names_where(lambda t: t.placements))}")
-            kind = places[0].kind
-            text = f"the {_words(o)} is {'in' if kind == 'in' else 'on'} the {_words(t)}"
-            return (put_in if kind == "in" else put_on)(o.name, t.name, text)
-        m = _DRAWER.match(clause)
-        if m:
-            ref = parse_phrase(m["obj"], clause)
-            _check_colour(ref, ref.type)
-            o = objects.resolve(ref, ref.type, clause)
-            if not CATALOG.get(o.type).drawer_handles:
-                with_drawers = CATALOG.names_where(lambda t: t.drawer_handles)
-                raise PlanningError(f"a {o.type.replace('_', ' ')} has no drawer to open or close (in "
-                                    f"{bounded(clause)}); objects with a drawer: {', '.join(with_drawers)}")
-            if m["verb"] in ("close", "shut"):
-                return close_drawer(o.name, f"the {_words(o)}'s drawer is shut")
-            return open_drawer(o.name, f"the {_words(o)}'s drawer is pulled open")
-        m = _HANG.match(clause)
-        if m:
-            o_ref, t_ref = parse_phrase(m["obj"], clause), parse_phrase(m["target"], clause)
-            _check_colour(o_ref, o_ref.type)
-            _check_colour(t_ref, t_ref.type)
-            o, t = objects.resolve(o_ref, o_ref.type, clause), objects.resolve(t_ref, t_ref.type, clause)
-            for x, kind, what in ((o, "loop", "hung up"), (t, "hook", "hung from")):
-                if CATALOG.get(x.type).point_of_kind(kind) is None:
-                    having = CATALOG.with_point(kind)
-                    raise PlanningError(f"a {x.type.replace('_', ' ')} has no {kind} to be {what} (in "
-                                        f"{bounded(clause)}); objects with one: {', '.join(having)}")
-            return hang(o.name, t.name, f"the {_words(o)} hangs on the {_words(t)}")
-        m = _FACE.match(clause)
-        if m:
-            ref = parse_phrase(m["obj"], clause)
-            _check_colour(ref, ref.type)
-            o = objects.resolve(ref, ref.type, clause)
-            if CATALOG.get(o.type).face is None:
-                faced = CATALOG.names_where(lambda t: t.face is not None)
-                raise PlanningError(f"a {o.type.replace('_', ' ')} has no face to turn towards the robot (in "
-                                    f"{bounded(clause)}); objects with one: {', '.join(faced)}")
-            return turn_to_face(o.name, f"the {_words(o)} is turned to face the robot, standing on the table")
-        m = _PRESS.match(clause)
-        if m:
-            ref = parse_phrase(m["obj"], clause)
-            _check_colour(ref, ref.type)
-            o = objects.resolve(ref, ref.type, clause)
-            fps = CATALOG.get(o.type).functional_points
-            if CATALOG.get(o.type).drawer_handles:
-                raise PlanningError(f"a {o.type.replace('_', ' ')}'s handle opens or closes its drawer, it "
-                                    f"is not pressed (in {bounded(clause)}); say 'open the {_words(o)}' or "
-                                    f"'close the {_words(o)}'")
-            if not fps or fps[0].joint is None:
-                raise PlanningError(f"a {o.type.replace('_', ' ')} cannot be pressed (in {bounded(clause)}); "
-                                    f"pressable: {', '.join(x.name for x in CATALOG.by_tag('pressable'))}")
-            point = None
-            if o.type == "switch":
-                if m["verb"] in ("turn off", "switch off"):
-                    raise PlanningError(f"the switch starts in its off position, so it cannot be turned "
-                                        f"off (in {bounded(clause)}); say 'turn on the switch' or "
-                                        "'flip the switch'")
-                point = fps[0].name
-            return press(o.name, f"the {_words(o)} is pressed", point=point)
-        raise PlanningError(f"cannot read {bounded(clause)} as a step: a step is 'put/place/move X on/in Y', "
-                            "'press/ring/flip Z', 'open/close the drawer', 'hang X on Y' or 'turn X to face "
-                            "me', naming catalog objects")
 
     def _understood(self, clauses: list[str], subtasks: list[Subtask]) -> str:
         seen = listed(list(dict.fromkeys(m.label() for m in find_mentions(words(" ; ".join(clauses))))))
@@ -483,4 +267,4 @@ class OfflinePlanner:
                 "VCAGE_LLM_MODEL set)")
 
 
-__all__ = ["ALIASES", "EXACT_MATCH", "MATCH_THRESHOLD", "SIZES", "OfflinePlanner", "split_clauses"]
+__all__ = ["ALIASES", "EXACT_MATCH", "MATCH_THRESHOLD", "SIZES", "OfflinePlanner"]

@@ -1,3 +1,13 @@
 """Built-in object types; importing this package registers them in ``CATALOG``."""
 
-from vcage.assets.objects import blocks, containers, devices, household, kitchen, office, tools  # noqa: F401
+from vcage.assets.objects import (  # noqa: F401
+    blocks,
+    containers,
+    devices,
+    household,
+    kitchen,
+    office,
+    playthings,
+    sundries,
+    tools,
+)
