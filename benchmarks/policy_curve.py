@@ -1,0 +1,96 @@
+"""Success against training: every kept checkpoint of a training run rolled out on the same scenes.
+
+Question: does the policy's success on held-out scenes still rise at the end of its budget (train
+longer), or did it level off or fall earlier (the budget is not what holds it back)? A run keeps all
+its checkpoints unless ``--keep-checkpoints`` was given (``vcage train`` keeps all by default; the
+experiment scripts keep two). Each checkpoint is evaluated like ``vcage evaluate CHECKPOINT``, on
+the run's dataset environment (or ``--env``), on ``--scenes`` (a JSON list of scene seeds, or an
+experiment's ``eval/TASK.json``) or the environment's own held-out scenes, with the same evaluation
+seed and batch for every checkpoint, so that the rows differ only in the weights. It prints, per
+checkpoint, the step, the passes over the data, the successes and their Wilson interval; a
+checkpoint's evaluation is cached beside it (``step-N.eval-<tag>.json``). With several runs (e.g.
+training seeds) it prints their rows side by side and the pooled rate per step.
+
+    LP_NUM_THREADS=1 .venv/bin/python benchmarks/policy_curve.py runs/mouse-seed0 runs/mouse-seed1 \\
+        --scenes work/eval/put_the_mouse_on_the_pad.json --episodes 50 --workers 2
+"""
+
+from __future__ import annotations
+
+import argparse
+import functools
+import json
+import re
+import time
+from pathlib import Path
+from typing import Any
+
+from policy_vcage_vs_vanilla import wilson
+
+
+def read_scenes(path: Path) -> list[int]:
+    data = json.loads(path.read_text())
+    seeds = data["solved"] if isinstance(data, dict) else data
+    if not isinstance(seeds, list) or not seeds or not all(isinstance(s, int) and s >= 0 for s in seeds):
+        raise SystemExit(f"{path}: expected a list of scene seeds (or an object with 'solved'), got "
+                         f"{data!r:.80}")
+    return seeds
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("runs", type=Path, nargs="+", help="training run directories (vcage train --out)")
+    parser.add_argument("--scenes", type=Path, help="scene seeds to roll out on (default: held-out scenes)")
+    parser.add_argument("--episodes", type=int, default=50)
+    parser.add_argument("--seed", type=int, default=0, help="evaluation seed")
+    parser.add_argument("--env", type=Path, help="evaluate in this dataset's environment")
+    parser.add_argument("--every", type=int, default=1,
+                        help="evaluate every k-th kept checkpoint (and the last)")
+    parser.add_argument("--workers", type=int, default=1)
+    parser.add_argument("--batch", type=int, default=8)
+    args = parser.parse_args()
+    from vcage.data import DatasetReader
+    from vcage.pipeline.evaluation import make_env
+    from vcage.policy.checkpoint import checkpoints, load_checkpoint
+    from vcage.policy.evaluate import evaluate
+
+    t0 = time.perf_counter()
+    scenes = read_scenes(args.scenes) if args.scenes else None
+    episodes = min(args.episodes, len(scenes)) if scenes else args.episodes
+    env_config = DatasetReader(args.env).config if args.env else None
+    factory = functools.partial(make_env, scenes=scenes) if scenes else None
+    tag = re.sub(r"[^A-Za-z0-9]+", "-", f"{args.scenes.stem if args.scenes else 'held-out'}-n{episodes}"
+                 f"-s{args.seed}-b{args.batch}")
+    table: dict[int, dict[int, tuple[int, int]]] = {}  # step -> run index -> (successes, episodes)
+    passes: dict[int, float] = {}
+    for index, run in enumerate(args.runs):
+        found = checkpoints(run)
+        if not found:
+            raise SystemExit(f"{run} holds no checkpoint: pass a vcage train --out directory")
+        chosen = found[::args.every] + ([found[-1]] if (len(found) - 1) % args.every else [])
+        for path in chosen:
+            cache = path.with_name(f"{path.stem}.eval-{tag}.json")
+            if not cache.is_file():
+                result = evaluate(path, episodes, seed=args.seed, env_config=env_config, threads=1,
+                                  make_env=factory, workers=args.workers, batch=args.batch)
+                cache.write_text(json.dumps(result.to_dict()))
+            record: dict[str, Any] = json.loads(cache.read_text())
+            payload = load_checkpoint(path)
+            step = int(payload["step"])
+            passes[step] = step * int(payload["config"]["batch_size"]) / int(payload["dataset"]["frames"])
+            table.setdefault(step, {})[index] = (int(record["successes"]), int(record["episodes"]))
+            print(f"{run.name}: step {step} {record['successes']}/{record['episodes']}", flush=True)
+    print(f"\n{'step':>7s} {'passes':>7s} " + " ".join(f"{r.name[-12:]:>12s}" for r in args.runs)
+          + f" {'pooled':>9s} {'Wilson 95%':>13s}")
+    for step in sorted(table):
+        cells = table[step]
+        s, n = sum(c[0] for c in cells.values()), sum(c[1] for c in cells.values())
+        low, high = wilson(s, n)
+        row = " ".join(f"{f'{cells[i][0]}/{cells[i][1]}' if i in cells else '-':>12s}"
+                       for i in range(len(args.runs)))
+        print(f"{step:7d} {passes[step]:7.1f} {row} {s / n:9.1%} {f'[{low:.0%}, {high:.0%}]':>13s}")
+    print(f"{time.perf_counter() - t0:.0f} s")
+
+
+if __name__ == "__main__":
+    main()
