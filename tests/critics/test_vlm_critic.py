@@ -110,6 +110,16 @@ def test_no_rejects_with_the_models_reason(server: FakeOpenAI) -> None:
     assert not verdict.accept and "beside the pad" in verdict.reason
 
 
+def test_a_rejection_is_coded_vlm_no_and_an_unusable_vote_adds_vlm_malformed(server: FakeOpenAI) -> None:
+    server.script(NO, YES, "sure, looks fine to me")
+    assert _critic(server).judge(_obs()).codes == ("vlm.no",)
+    accepted = _critic(server).judge(_obs())
+    assert accepted.accept and accepted.codes == () and "codes" not in accepted.to_dict()
+    malformed = _critic(server).judge(_obs())
+    assert not malformed.accept and malformed.codes == ("vlm.no", "vlm.malformed")
+    assert malformed.to_dict()["codes"] == ["vlm.no", "vlm.malformed"]
+
+
 def test_majority_and_unanimous_votes(server: FakeOpenAI) -> None:
     server.script(YES, NO, YES)
     assert _critic(server, votes=3).judge(_obs()).accept

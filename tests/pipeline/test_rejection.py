@@ -21,7 +21,10 @@ from vcage.data.layout import ATTEMPTS_LOG
 from vcage.pipeline.attempt_log import read
 from vcage.pipeline.audit import audit
 from vcage.pipeline.config import GenerateConfig
-from vcage.pipeline.generate import generate
+from vcage.pipeline.episode import Attempt, Timing
+from vcage.pipeline.generate import Funnel, _count, generate
+from vcage.pipeline.sampling import log_record
+from vcage.pipeline.stage import Stage
 from vcage.planning import make_planner
 from vcage.planning.schema import Plan, Predicate, Subtask
 from vcage.scene.instantiate import SceneConfig
@@ -88,5 +91,22 @@ def test_a_critic_that_accepts_a_failure_records_label_noise(tmp_path: Path) -> 
 def test_the_oracle_critic_rejects_the_failure_and_gives_up(tmp_path: Path) -> None:
     funnel = generate(SHORT, 1, tmp_path, _cfg("oracle", attempts=2), plan=_failing_plan())
     assert funnel.accepted == 0 and funnel.given_up == 1 and funnel.stages["critic"] == 2
-    assert dict(funnel.reasons) == {("critic", "subtask N: predicates do not hold: pressed(bell)"): 2}
+    assert dict(funnel.reasons) == {("critic", "pressed.false"): 2}  # the oracle's code, from its verdict
     assert funnel.label_noise == 0.0 and not (tmp_path / "meta" / "info.json").exists()
+
+
+def test_the_funnel_counts_rejections_by_their_codes_and_records_without_codes_by_text() -> None:
+    """A rejection the critic coded counts under its first code, whatever its text; one without codes
+    (a skill's failure, a critic that gives none, a log written before codes were) under its text."""
+    funnel = Funnel()
+    shallow, missed = ("pressed.too_shallow",), ("on.not_over_target", "released.still_touching")
+    records = [log_record(0, i, Attempt(7, Stage.CRITIC, f"subtask 1: pressed(bell): {mm} mm short",
+                                        codes=codes))
+               for i, (mm, codes) in enumerate([(3.1, shallow), (1.2, shallow), (0.0, missed), (2.5, ())])]
+    records.append(log_record(0, 4, Attempt(7, Stage.SKILL, "no grasp at 3 cm")))
+    assert [r.get("codes") for r in records] == [list(shallow), list(shallow), list(missed), None, None]
+    for record in records:
+        _count(funnel, record, Timing())
+    assert dict(funnel.reasons) == {("critic", "pressed.too_shallow"): 2, ("critic", "on.not_over_target"): 1,
+                                    ("critic", "subtask N: pressed(bell): N mm short"): 1,
+                                    ("skill", "no grasp at N cm"): 1}

@@ -52,6 +52,20 @@ def test_funnel_counts_stages_reasons_and_given_up_episodes() -> None:
         ("critic", "subtask N: not pressed", 2), ("placement", "no room for N objects", 1)]
 
 
+def test_funnel_counts_coded_rejections_by_their_first_code_and_others_by_text() -> None:
+    coded = [_record(1, 0, "critic", "subtask 1: pressed(bell): the hand stopped 3.1 mm short", accept=False),
+             _record(1, 1, "critic", "subtask 2: pressed(bell): the hand stopped 1.2 mm short", accept=False),
+             _record(2, 0, "critic", "subtask 1: on(a, b): only 3% of a overlaps b; released(a): ...",
+                     accept=False)]
+    for rec, codes in zip(coded, (["pressed.too_shallow"], ["pressed.too_shallow"],
+                                  ["on.not_over_target", "released.still_touching"]), strict=True):
+        rec["codes"] = codes
+    funnel = count([*coded, _record(3, 0, "critic", "subtask 1: not pressed; 3 px", accept=False)])
+    assert [(r.stage, r.reason, r.attempts) for r in funnel.reasons] == [
+        ("critic", "pressed.too_shallow", 2), ("critic", "on.not_over_target", 1),
+        ("critic", "subtask N: not pressed", 1)]
+
+
 def test_rejections_put_disagreements_first_and_pair_verdict_with_oracle() -> None:
     records = [_record(0, 0, "placement", "no room"),
                _record(0, 1, "critic", "subtask 1: wrong", oracle=False, accept=False),  # agrees

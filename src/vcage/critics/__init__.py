@@ -9,10 +9,12 @@ from vcage.critics.base import (
     Critic,
     CriticConfig,
     Observation,
+    Reason,
     Recorder,
     Verdict,
     View,
     make_critic,
 )
 
-__all__ = ["CRITICS", "Critic", "CriticConfig", "Observation", "Recorder", "Verdict", "View", "make_critic"]
+__all__ = ["CRITICS", "Critic", "CriticConfig", "Observation", "Reason", "Recorder", "Verdict", "View",
+           "make_critic"]

@@ -41,16 +41,38 @@ class Observation:
     oracle: dict[str, bool] = field(default_factory=dict)  # ground truth (the oracle critic only)
 
 
+class Reason(str):
+    """Why a check failed: its text (a ``str``, compared and printed as the text) and ``code``, a short
+    snake_case name of the cause, so that rejections can be counted by cause without reading the
+    text (``Reason("too_shallow", "the hand stopped 3.1 mm short of pressing bell")``)."""
+
+    code: str
+
+    def __new__(cls, code: str, text: str) -> Reason:
+        self = super().__new__(cls, text)
+        self.code = code
+        return self
+
+    def __getnewargs__(self) -> tuple[str, str]:  # type: ignore[override]  # pickles and copies keep the code
+        return self.code, str(self)
+
+
 @dataclass(frozen=True)
 class Verdict:
+    """``codes``: machine-readable causes of a rejection (e.g. ``pressed.too_shallow``), none when the
+    critic accepts or gives no codes."""
+
     accept: bool
     reason: str
     details: dict[str, Any] = field(default_factory=dict)
+    codes: tuple[str, ...] = ()
 
     def to_dict(self) -> dict[str, Any]:
         out: dict[str, Any] = {"accept": self.accept, "reason": self.reason}
         if self.details:
             out["details"] = self.details
+        if self.codes:
+            out["codes"] = list(self.codes)
         return out
 
 

@@ -13,9 +13,12 @@ class OracleCritic(Critic):
     needs_views = False
 
     def judge(self, obs: Observation) -> Verdict:
+        """A rejection's ``codes`` name each predicate that does not hold, by its name (``pressed.false``
+        for ``pressed(bell)``), in the oracle's order."""
         failed = [k for k, v in obs.oracle.items() if not v]
         if failed:
-            return Verdict(False, "predicates do not hold: " + ", ".join(failed))
+            codes = tuple(f"{k.split('(')[0].strip()}.false" for k in failed)
+            return Verdict(False, "predicates do not hold: " + ", ".join(failed), codes=codes)
         return Verdict(True, "all predicates hold: " + ", ".join(obs.oracle))
 
 

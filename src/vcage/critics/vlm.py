@@ -80,7 +80,8 @@ class VLMCritic(Critic):
 
     def judge(self, obs: Observation) -> Verdict:
         """The votes' verdict; raises ``BackendUnavailableError`` (or ``BackendError``) instead of
-        voting when a request fails."""
+        voting when a request fails. A rejection's ``codes``: ``vlm.no``, and ``vlm.malformed`` where an
+        unusable answer was among the votes."""
         messages = [Message("system", SYSTEM), self._question(obs)]
         votes: list[dict[str, Any]] = []
         for _ in range(self.config.votes):
@@ -88,8 +89,10 @@ class VLMCritic(Critic):
         yes = sum(v["success"] for v in votes)
         accept = yes == len(votes) if self.config.rule == "all" else yes * 2 > len(votes)
         reasons = "; ".join(str(v["reason"]) for v in votes)
+        malformed = sum(v["malformed"] for v in votes)
+        codes = () if accept else ("vlm.no", *(("vlm.malformed",) if malformed else ()))
         return Verdict(accept, f"{yes}/{len(votes)} votes yes: {reasons}",
-                       {"votes": votes, "malformed": sum(v["malformed"] for v in votes)})
+                       {"votes": votes, "malformed": malformed}, codes)
 
     def _question(self, obs: Observation) -> Message:
         press = any(p.name == "pressed" for p in obs.subtask.predicates) and bool(obs.during)

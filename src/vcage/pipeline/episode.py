@@ -90,6 +90,7 @@ class Attempt:
     fused: tuple[tuple[str, str, float], ...] = ()
     timing: Timing = field(default_factory=Timing)
     critic_view: bytes | None = None  # PNG of the views the critic rejected (:mod:`.critic_views`)
+    codes: tuple[str, ...] = ()  # the critic's reason codes for its rejection (its verdict's ``codes``)
 
     @property
     def accepted(self) -> bool:
@@ -195,5 +196,6 @@ def _execute(plan: Plan, seed: int, cfg: GenerateConfig, critic: Critic | None, 
         else:
             verdict = last.verdict or {}
             out.stage, out.reason = Stage.CRITIC, f"subtask {last.index + 1}: {verdict.get('reason', '')}"
+            out.codes = tuple(verdict.get("codes", ()))
             out.critic_view = sheet_png(verifier.rejected_views) if verifier is not None else None
     return out

@@ -85,12 +85,16 @@ def _audit(result: Attempt) -> list[dict[str, Any]]:
 
 def log_record(episode: int, index: int, result: Attempt) -> dict[str, Any]:
     """The attempt's line in ``meta/vcage_attempts.jsonl``: outcome, oracle audit, verdicts, and the
-    plan's objects fused into another object where the rollout started (an unchecked scene can)."""
-    return {"episode": episode, "attempt": index, "seed": result.seed, "stage": result.stage,
-            "reason": result.reason, "oracle_success": result.oracle_success,
-            "audit": _audit(result),
-            "verdicts": [o.verdict for o in result.rollout.outcomes] if result.rollout else [],
-            "fused_at_start": [[a, b, round(d, 5)] for a, b, d in result.fused]}
+    plan's objects fused into another object where the rollout started (an unchecked scene can);
+    ``codes``, only where the critic rejected it with reason codes (see :class:`~vcage.critics.Verdict`)."""
+    record = {"episode": episode, "attempt": index, "seed": result.seed, "stage": result.stage,
+              "reason": result.reason, "oracle_success": result.oracle_success,
+              "audit": _audit(result),
+              "verdicts": [o.verdict for o in result.rollout.outcomes] if result.rollout else [],
+              "fused_at_start": [[a, b, round(d, 5)] for a, b, d in result.fused]}
+    if result.codes:
+        record["codes"] = list(result.codes)
+    return record
 
 
 def episode_data(plan: Plan, cfg: GenerateConfig, result: Attempt,

@@ -2,7 +2,9 @@
 
 Counted from the attempt log (every attempt of every run that committed an episode), so the
 numbers are the dataset's, whatever runs made it. Rejection reasons are grouped as ``vcage
-generate`` groups them when it prints a run's funnel: the first clause, numbers replaced by ``N``.
+generate`` groups them when it prints a run's funnel: by the first of the critic's reason codes
+where the record has them (``pressed.too_shallow``), else by the reason's first clause, numbers
+replaced by ``N`` (a skill's failure, a critic without codes, a log written before codes were).
 """
 
 from __future__ import annotations
@@ -61,7 +63,8 @@ def count(records: Sequence[dict[str, Any]]) -> FunnelCounts:
         if stage == Stage.ACCEPTED:
             accepted_samples.add(int(rec["episode"]))
         else:
-            reasons[(stage, reason_group(str(rec.get("reason", ""))))] += 1
+            codes = rec.get("codes")
+            reasons[(stage, str(codes[0]) if codes else reason_group(str(rec.get("reason", ""))))] += 1
     known = {str(s): stages.get(str(s), 0) for s in STAGES}
     known.update({s: n for s, n in stages.items() if s not in known})  # a stage of a newer version
     return FunnelCounts(

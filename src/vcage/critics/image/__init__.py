@@ -89,7 +89,7 @@ from pathlib import Path
 from typing import Any
 
 from vcage.critics import masks
-from vcage.critics.base import CRITICS, Critic, CriticConfig, Observation, Verdict
+from vcage.critics.base import CRITICS, Critic, CriticConfig, Observation, Reason, Verdict
 from vcage.critics.image import thresholds
 from vcage.critics.image.drawers import _closed, _opened
 from vcage.critics.image.pose import _facing, _hanging, _lifted, _near, _on_table, _side, _upright
@@ -123,19 +123,25 @@ class ImageCritic(Critic):
         return thresholds.values()
 
     def judge(self, obs: Observation) -> Verdict:
+        """Every predicate's check; a rejection's ``codes`` name each failed predicate with its
+        reason's code (``pressed.too_shallow``, see :data:`~vcage.critics.image.reasons.REASON_CODES`),
+        in the predicates' order."""
         checks: dict[str, bool] = {}
         reasons: list[str] = []
+        codes: list[str] = []
         for pred in obs.subtask.predicates:
             ok, why = IMAGE_CHECKS.get(pred.name)(obs, *pred.args)
             checks[str(pred)] = ok
             if not ok:
                 reasons.append(f"{pred}: {why}")
+                codes.append(f"{pred.name}.{why.code if isinstance(why, Reason) else UNSPECIFIED}")
         accept = not reasons
         reason = "; ".join(reasons) if reasons else "all image checks pass"
-        return Verdict(accept, reason, {"checks": checks})
+        return Verdict(accept, reason, {"checks": checks}, tuple(codes))
 
 
-ImageCheck = Callable[..., tuple[bool, str]]  # (observation, *objects) -> (holds, why)
+ImageCheck = Callable[..., tuple[bool, str]]  # (observation, *objects) -> (holds, why: a Reason if not)
+UNSPECIFIED = "unspecified"  # the code of a failure whose why is not a Reason: no check returns one
 IMAGE_CHECKS: Registry[ImageCheck] = Registry("image check")
 _checks: dict[str, ImageCheck] = {
     "on": _on, "inside": _inside, "released": _released, "pressed": _pressed, "upright": _upright,

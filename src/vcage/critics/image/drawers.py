@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from vcage.assets.annotations import Placement
-from vcage.critics.base import Observation
+from vcage.critics.base import Observation, Reason
 from vcage.critics.image.measure import _heights, _hidden, _highest, _mask, _scale, _type_of
 from vcage.critics.image.thresholds import (
     FLOOR_TOL,
@@ -20,7 +20,7 @@ from vcage.critics.masks import (
 )
 
 
-def _drawer(obs: Observation, x: str) -> tuple[float, float, bool] | str:
+def _drawer(obs: Observation, x: str) -> tuple[float, float, bool] | Reason:
     """How far ``x``'s drawer is out after the subtask, by the top view, the travel that counts as
     open (both in metres) and whether the robot hides part of ``x``; or why it cannot be told.
 
@@ -32,13 +32,13 @@ def _drawer(obs: Observation, x: str) -> tuple[float, float, bool] | str:
     after = obs.after.get(TOP)
     otype = _type_of(obs, x)
     if after is None or otype is None:
-        return f"the top view after the subtask and {x}'s type are needed"
+        return Reason("missing_view", f"the top view after the subtask and {x}'s type are needed")
     point = otype.drawer_handle(obs.subtask.args.get("point")) or otype.drawer_handle()
     if point is None:
-        return f"{x} ({otype.name}) has no drawer"
+        return Reason("no_drawer", f"{x} ({otype.name}) has no drawer")
     heights, mask = _heights(after), _mask(obs, after, x)
     if heights is None or after.pixel_size is None or mask.sum() < MIN_RELIEF_PX:
-        return f"{x} is not seen in the top view's heights"
+        return Reason("not_visible", f"{x} is not seen in the top view's heights")
     scale = _scale(otype, heights, mask)
     long, short = rectangle_sides(mask)
     out = (long + short) * after.pixel_size - (otype.size[0] + otype.size[1]) * scale
@@ -57,31 +57,34 @@ def _in_drawer(obs: Observation, a: str, b: str, place: Placement) -> tuple[bool
     otype = _type_of(obs, b)
     assert otype is not None  # _inside found b's drawer in it
     if before is None or after is None or hb is None or ha is None:
-        return False, "the top view's heights before and after are needed"
+        return False, Reason("missing_view", "the top view's heights before and after are needed")
     mb, ma = _mask(obs, before, b), _mask(obs, after, a)
     if not mb.any() or not ma.any():
-        return False, f"{a} or {b} is not seen from the top"
+        return False, Reason("not_visible", f"{a} or {b} is not seen from the top")
     drawer = _drawer(obs, b)
     if isinstance(drawer, str) or drawer[0] < drawer[1]:
-        return False, f"{b}'s drawer is not open after the subtask, so {a} cannot be seen in it"
+        return False, Reason("drawer_not_open",
+                             f"{b}'s drawer is not open after the subtask, so {a} cannot be seen in it")
     top = _highest(hb, mb)
     body = mb & (hb >= top - TOP_BAND_BODY)
     share = float((ma & dilate(mb & ~body, 1)).sum() / ma.sum())
     if share < IN_DRAWER:
-        return False, f"only {share:.0%} of {a} lies over {b}'s open drawer from the top"
+        return False, Reason("not_over_target",
+                             f"only {share:.0%} of {a} lies over {b}'s open drawer from the top")
     scale = _scale(otype, hb, mb)
     lift = max(0.0, top - otype.size[2] * scale)  # standing on something, not on the table
     rim, floor = lift + (place.pos[2] + place.wall_height) * scale, lift + place.pos[2] * scale
     low = float(ha[ma].min())
     if low > rim:
-        return False, f"{a} lies {100 * (low - rim):.1f} cm higher than the rim of {b}'s drawer"
+        return False, Reason("too_high",
+                             f"{a} lies {100 * (low - rim):.1f} cm higher than the rim of {b}'s drawer")
     atype = _type_of(obs, a)
     if atype is not None:
         a_top = _highest(ha, ma)
         least = floor + atype.size[2] * atype.scale_range[0] - FLOOR_TOL
         if a_top < least:
-            return False, (f"{a}'s top is {100 * (least - a_top):.1f} cm lower than lying on the floor of "
-                           f"{b}'s drawer makes it: {a} lies beside the drawer")
+            return False, Reason("too_low", f"{a}'s top is {100 * (least - a_top):.1f} cm lower than lying "
+                                 f"on the floor of {b}'s drawer makes it: {a} lies beside the drawer")
     return True, f"{share:.0%} of {a} over {b}'s open drawer"
 
 
@@ -94,7 +97,7 @@ def _opened(obs: Observation, x: str) -> tuple[bool, str]:
         return True, "opened"
     why = (f"{x}'s drawer is out about {100 * out:.1f} cm in the top view, less than the "
            f"{100 * (travel + OPEN_MARGIN):.0f} cm that count as open")
-    return False, why + (" (the robot hides part of it)" if hidden else "")
+    return False, Reason("drawer_not_open", why + (" (the robot hides part of it)" if hidden else ""))
 
 
 def _closed(obs: Observation, x: str) -> tuple[bool, str]:
@@ -103,7 +106,9 @@ def _closed(obs: Observation, x: str) -> tuple[bool, str]:
         return False, drawer
     out, _, hidden = drawer
     if hidden:
-        return False, f"the robot hides part of {x} in the top view: its drawer may stand out"
+        return False, Reason("robot_hides",
+                             f"the robot hides part of {x} in the top view: its drawer may stand out")
     if out > SHUT_OUT:
-        return False, f"{x}'s drawer is out about {100 * out:.1f} cm in the top view, not shut"
+        return False, Reason("drawer_not_shut",
+                             f"{x}'s drawer is out about {100 * out:.1f} cm in the top view, not shut")
     return True, "closed"

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from vcage.assets.catalog import ObjectType
-from vcage.critics.base import Observation, View
+from vcage.critics.base import Observation, Reason, View
 from vcage.critics.image.measure import (
     _heights,
     _highest,
@@ -52,7 +52,7 @@ from vcage.critics.masks import (
 )
 
 
-def _on_its_side(obs: Observation, top: View, a: str, b: str) -> str | None:
+def _on_its_side(obs: Observation, top: View, a: str, b: str) -> Reason | None:
     """Why ``a`` lies on its side on ``b`` instead of standing on its base (None if it does not, or
     the views cannot tell). Lying on a side, its top stands at most its longest side across above
     ``b``'s surface; standing, its own height (see :func:`_standing_and_lying`). Where the first is
@@ -76,16 +76,16 @@ def _on_its_side(obs: Observation, top: View, a: str, b: str) -> str | None:
         drop, radius = fall
         if drop >= radius:
             return None
-        return (f"{a} shows no inside from the top (its top falls {100 * drop:.1f} cm to its lowest, lying "
-                f"on its side at most {100 * radius:.1f} cm): it lies on its side")
+        return Reason("lying_on_side", f"{a} shows no inside from the top (its top falls {100 * drop:.1f} cm "
+                      f"to its lowest, lying on its side at most {100 * radius:.1f} cm): it lies on its side")
     standing, lying = _standing_and_lying(obs, otype, before, a)
     surface = _surface(obs, b, _peak(hb, mb))
     if standing - lying < SIDE_GAP or surface is None:
         return None
     high = float(np.percentile(ha[now], 95)) - surface
     if high < (standing + lying) / 2:
-        return (f"{a}'s top is {100 * high:.1f} cm above {b}'s surface, {100 * standing:.1f} cm standing "
-                f"and {100 * lying:.1f} cm lying: it lies on its side")
+        return Reason("lying_on_side", f"{a}'s top is {100 * high:.1f} cm above {b}'s surface, "
+                      f"{100 * standing:.1f} cm standing and {100 * lying:.1f} cm lying: it lies on its side")
     return None
 
 
@@ -129,7 +129,7 @@ def _standing_and_lying(obs: Observation, otype: ObjectType, before: View, a: st
 
 def _not_down(obs: Observation, top: View, a: str, surface: float | None, floor: float, where: str,
               skip: tuple[str, ...], standing: bool = False, any_way_up: bool = False,
-              slope: float = 0.0) -> str | None:
+              slope: float = 0.0) -> Reason | None:
     """Why ``a`` cannot rest on a support whose surface lies ``surface`` above the table (``where``
     names it), from the top view's heights; None if they allow it (or cannot tell). Without a known
     surface only clutter higher than ``floor`` counts (see :func:`_landed_on_other`). ``standing``:
@@ -148,10 +148,12 @@ def _not_down(obs: Observation, top: View, a: str, surface: float | None, floor:
     if surface is not None and height is not None:
         above = float(ha[ma].min()) - height - surface
         if above > HEIGHT_TOL:
-            return f"{a} stands {100 * above:.1f} cm higher than resting on {where} allows"
+            return Reason("too_high",
+                          f"{a} stands {100 * above:.1f} cm higher than resting on {where} allows")
         taller = _highest(ha, ma, rim=_open(_type_of(obs, a))) - height - surface
         if standing and taller > TOP_TOL:
-            too_tall = f"{a}'s top is {100 * taller:.1f} cm higher than {a} standing on {where} reaches"
+            too_tall = Reason("too_tall", f"{a}'s top is {100 * taller:.1f} cm higher than {a} standing on "
+                              f"{where} reaches")
     surface = floor if surface is None else surface
     for i, c in enumerate(obs.labels):
         was = before.segmentation == i
@@ -178,11 +180,12 @@ def _not_down(obs: Observation, top: View, a: str, surface: float | None, floor:
             continue  # the table shows there: ``c`` is gone (knocked off, out of sight)
         rise = float(np.median(moved(np.where(was, hb, 0.0), move)[under])) - surface
         if rise > SUPPORT_TOL or (rise > THIN_SUPPORT and under.sum() >= MIN_OVERLAP * ma.sum()):
-            return f"{a} lies over {c}, whose top is {100 * rise:.1f} cm above {where}"
+            return Reason("on_other_object",
+                          f"{a} lies over {c}, whose top is {100 * rise:.1f} cm above {where}")
     return too_tall
 
 
-def _turned_over(obs: Observation, top: View, a: str) -> str | None:
+def _turned_over(obs: Observation, top: View, a: str) -> Reason | None:
     """Why ``a`` lies turned over (None if its top kept its shape, or the views cannot tell): it stood
     on its base before the subtask (see :data:`FOOTPRINT`) with a curved top (at least :data:`CURVED`
     from a plane), and its top is now nearly flat (under :data:`FLAT_TOP` of that), as a mouse on its
@@ -199,12 +202,12 @@ def _turned_over(obs: Observation, top: View, a: str) -> str | None:
     flat = TYPE_FLAT * otype.top_relief * otype.scale_range[0]
     why = _flatter_than_before(obs, a, otype, before, now)
     if why is None and now is not None and now < flat:
-        return (f"{a}'s top is flat ({1000 * now:.1f} mm from a plane; {otype.name} standing shows at least "
-                f"{1000 * flat / TYPE_FLAT:.1f} mm): it lies turned over")
+        return Reason("turned_over", f"{a}'s top is flat ({1000 * now:.1f} mm from a plane; {otype.name} "
+                      f"standing shows at least {1000 * flat / TYPE_FLAT:.1f} mm): it lies turned over")
     return why
 
 
-def _slanted_dome(obs: Observation, top: View, a: str, b: str) -> str | None:
+def _slanted_dome(obs: Observation, top: View, a: str, b: str) -> Reason | None:
     """Why ``a``, of a type that declares a domed top (``top_relief``: a mouse), does not rest on its
     base on ``b`` (None if it may, or the view cannot tell): the plane fitting its top's heights
     slopes by more than :data:`DOME_SLOPE` beyond ``b``'s surface. Standing on its base a dome's plane
@@ -223,12 +226,12 @@ def _slanted_dome(obs: Observation, top: View, a: str, b: str) -> str | None:
     bound = float(np.tan(ramp)) + DOME_SLOPE
     if fit[2] <= bound:
         return None
-    return (f"{a}'s domed top slopes {fit[2]:.2f} (rise over run), where standing on its base on {b} it "
-            f"slopes at most {bound:.2f}: it lies tipped over at a slant")
+    return Reason("tilted", f"{a}'s domed top slopes {fit[2]:.2f} (rise over run), where standing on its "
+                  f"base on {b} it slopes at most {bound:.2f}: it lies tipped over at a slant")
 
 
 def _flatter_than_before(obs: Observation, a: str, otype: ObjectType, before: View,
-                         now: float | None) -> str | None:
+                         now: float | None) -> Reason | None:
     """The first reason of :func:`_turned_over` (``now``: the relief of ``a``'s top after)."""
     mask = _mask(obs, before, a)
     if not _on_its_base(otype, before, mask):
@@ -237,6 +240,6 @@ def _flatter_than_before(obs: Observation, a: str, otype: ObjectType, before: Vi
     if was is None or now is None or was < CURVED:
         return None
     if now < FLAT_TOP * was:
-        return (f"{a}'s top is flat now ({1000 * now:.1f} mm from a plane, {1000 * was:.1f} mm before): "
-                "it lies turned over")
+        return Reason("turned_over", f"{a}'s top is flat now ({1000 * now:.1f} mm from a plane, "
+                      f"{1000 * was:.1f} mm before): it lies turned over")
     return None

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from vcage.critics.base import Observation, View
+from vcage.critics.base import Observation, Reason, View
 from vcage.critics.image.lying import _not_down
 from vcage.critics.image.measure import (
     _heights,
@@ -52,22 +52,25 @@ def _upright(obs: Observation, x: str) -> tuple[bool, str]:
     before, after = obs.before.get(TOP), obs.after.get(TOP)
     fb, fa = obs.before.get(FRONT), obs.after.get(FRONT)
     if before is None or after is None or fb is None or fa is None:
-        return False, "the top and front views before and after are needed"
+        return False, Reason("missing_view", "the top and front views before and after are needed")
     mb, ma = _mask(obs, before, x), _mask(obs, after, x)
     hid_b, hid_a = _hidden(before, mb), _hidden(after, ma)
     area_b, area_a = int(mb.sum()), int(ma.sum())
     if area_b:  # the robot hides at most about the pixels it covers around the outline
         if area_a > AREA_RATIO[1] * (area_b + hid_b) or area_a + hid_a < AREA_RATIO[0] * area_b:
-            return False, f"{x}'s top-view area changed by x{area_a / area_b:.2f} (tipped over?)"
+            return False, Reason("area_changed",
+                                 f"{x}'s top-view area changed by x{area_a / area_b:.2f} (tipped over?)")
         if not hid_a and not hid_b and area_a:
             axes = spread(ma)[-1] / max(1e-9, spread(mb)[-1])
             if not 1 / SHAPE_RATIO <= axes <= SHAPE_RATIO:
-                return False, f"{x}'s top-view outline stretched by x{axes:.2f} (tipped over?)"
+                return False, Reason("shape_changed",
+                                     f"{x}'s top-view outline stretched by x{axes:.2f} (tipped over?)")
     hb, ha = _heights(before), _heights(after)
     if hb is not None and ha is not None and mb.any() and ma.any():  # its highest point, from the top
         was, now = (_highest(h, m) for h, m in ((hb, mb), (ha, ma)))
         if now < HEIGHT_RATIO * was:
-            return False, f"{x}'s top stands x{now / max(was, 1e-9):.2f} as high as before (tipped over?)"
+            return False, Reason("lower_than_before", f"{x}'s top stands x{now / max(was, 1e-9):.2f} as high "
+                                 "as before (tipped over?)")
         off = _off_height(obs, after, x, now) or _tipped_axis(obs, after, x)
         if off is not None:
             return False, off
@@ -76,11 +79,12 @@ def _upright(obs: Observation, x: str) -> tuple[bool, str]:
     # the vertical changes too: a board's plate seen edge-on, its top edge runs away from the camera)
     rb, ra = rows_of(_mask(obs, fb, x)), rows_of(_mask(obs, fa, x))
     if rb and ra and (ra[1] - ra[0] + 1) < HEIGHT_RATIO * (rb[1] - rb[0] + 1):
-        return False, f"{x} looks lower in the front view than before (tipped over?)"
+        return False, Reason("lower_than_before",
+                             f"{x} looks lower in the front view than before (tipped over?)")
     return True, "upright"
 
 
-def _off_height(obs: Observation, top: View, x: str, high: float) -> str | None:
+def _off_height(obs: Observation, top: View, x: str, high: float) -> Reason | None:
     """Why ``x``, whose highest point stands ``high`` above the table, cannot stand upright on the
     table (None if it can, or its type cannot tell): standing on its base its top is at most its
     type's height at the largest scale (plus :data:`UPRIGHT_TOL`); higher, it stands tipped on a side
@@ -92,11 +96,12 @@ def _off_height(obs: Observation, top: View, x: str, high: float) -> str | None:
         return None
     if high > otype.size[2] * otype.scale_range[1] + UPRIGHT_TOL \
             and _not_down(obs, top, x, None, 0.0, "the table", (x,)) is None:
-        return f"{x}'s top is {100 * high:.1f} cm above the table, higher than {x} standing reaches (tipped?)"
+        return Reason("too_tall", f"{x}'s top is {100 * high:.1f} cm above the table, higher than {x} "
+                      "standing reaches (tipped?)")
     return None
 
 
-def _tipped_axis(obs: Observation, top: View, x: str) -> str | None:
+def _tipped_axis(obs: Observation, top: View, x: str) -> Reason | None:
     """Why ``x`` stands tilted by more than :data:`UPRIGHT_TILT` (None if it does not, or the view or
     its type cannot tell), from where its top lies over its base. Only for a type with a round base
     (size x equal to size y) whose press point lies on its axis at its top (a bell's button): upright,
@@ -128,9 +133,9 @@ def _tipped_axis(obs: Observation, top: View, x: str) -> str | None:
     bound = float(np.sin(UPRIGHT_TILT)) * point.pos[2] * lo
     if off <= bound:
         return None
-    return (f"{x}'s {point.name} lies {100 * off:.1f} cm off the centre of its base from the top, where "
-            f"standing within {UPRIGHT_TILT} rad of upright it lies at most {100 * bound:.1f} cm off: "
-            "it tilts")
+    return Reason("tilted", f"{x}'s {point.name} lies {100 * off:.1f} cm off the centre of its base from the "
+                  f"top, where standing within {UPRIGHT_TILT} rad of upright it lies at most "
+                  f"{100 * bound:.1f} cm off: it tilts")
 
 
 def _on_table(obs: Observation, a: str) -> tuple[bool, str]:
@@ -139,16 +144,16 @@ def _on_table(obs: Observation, a: str) -> tuple[bool, str]:
         return ok, why
     top = obs.after.get(TOP)
     if top is None:
-        return False, "the top view is needed"
+        return False, Reason("missing_view", "the top view is needed")
     ma = _mask(obs, top, a)
     if not ma.any():
-        return False, f"{a} is not visible from the top"
+        return False, Reason("not_visible", f"{a} is not visible from the top")
     for i, other in enumerate(obs.labels):
         if other == a:
             continue
         mo = top.segmentation == i
         if mo.sum() > ma.sum() and (ma & hull(mo)).sum() > MIN_OVERLAP * ma.sum():
-            return False, f"{a} lies over {other}, not on the table"
+            return False, Reason("on_other_object", f"{a} lies over {other}, not on the table")
     high = _not_down(obs, top, a, 0.0, 0.0, "the table", (a,))  # heights are above the table
     if high is not None:
         return False, high
@@ -158,42 +163,46 @@ def _on_table(obs: Observation, a: str) -> tuple[bool, str]:
 def _side(obs: Observation, a: str, b: str, left: bool) -> tuple[bool, str]:
     top = obs.after.get(TOP)
     if top is None:
-        return False, "the top view is needed"
+        return False, Reason("missing_view", "the top view is needed")
     ca, cb = np.nonzero(_mask(obs, top, a))[1], np.nonzero(_mask(obs, top, b))[1]
     if not len(ca) or not len(cb):
-        return False, "both objects must be visible from the top"
+        return False, Reason("not_visible", "both objects must be visible from the top")
     d = float(cb.mean() - ca.mean()) if left else float(ca.mean() - cb.mean())
-    return d >= COL_MARGIN, f"column difference {d:.0f} px"
+    if d < COL_MARGIN:
+        return False, Reason("wrong_side", f"column difference {d:.0f} px")
+    return True, f"column difference {d:.0f} px"
 
 
 def _near(obs: Observation, a: str, b: str) -> tuple[bool, str]:
     top = obs.after.get(TOP)
     if top is None or top.pixel_size is None:
-        return False, "the orthographic top view is needed"
+        return False, Reason("missing_view", "the orthographic top view is needed")
     pa, pb = np.nonzero(_mask(obs, top, a)), np.nonzero(_mask(obs, top, b))
     if not len(pa[0]) or not len(pb[0]):
-        return False, "both objects must be visible from the top"
+        return False, Reason("not_visible", "both objects must be visible from the top")
     rows = float(np.mean(pa[0]) - np.mean(pb[0]))
     cols = float(np.mean(pa[1]) - np.mean(pb[1]))
     d = float(np.hypot(rows, cols)) * top.pixel_size
-    return d <= NEAR, f"{d * 100:.0f} cm apart from the top"
+    if d > NEAR:
+        return False, Reason("too_far", f"{d * 100:.0f} cm apart from the top")
+    return True, f"{d * 100:.0f} cm apart from the top"
 
 
 def _lifted(obs: Observation, a: str) -> tuple[bool, str]:
     fb, fa, top = obs.before.get(FRONT), obs.after.get(FRONT), obs.after.get(TOP)
     if fb is None or fa is None or top is None:
-        return False, "the front views before and after and the top view are needed"
+        return False, Reason("missing_view", "the front views before and after and the top view are needed")
     rb, ra = rows_of(_mask(obs, fb, a)), rows_of(_mask(obs, fa, a))
     if rb is None or ra is None:
-        return False, f"{a} is not visible from the front"
+        return False, Reason("not_visible", f"{a} is not visible from the front")
     rise = rb[1] - ra[1]
     if rise < LIFT_ROWS:
-        return False, f"{a}'s bottom rose by {rise} px in the front view"
+        return False, Reason("too_low", f"{a}'s bottom rose by {rise} px in the front view")
     ma = _mask(obs, top, a)
     for i, other in enumerate(obs.labels):
         mo = top.segmentation == i
         if other != a and mo.sum() > ma.sum() and (ma & hull(mo)).sum() > MIN_OVERLAP * ma.sum():
-            return False, f"{a} rests on {other}"
+            return False, Reason("on_other_object", f"{a} rests on {other}")
     return True, f"rose by {rise} px"
 
 
@@ -211,34 +220,38 @@ def _facing(obs: Observation, a: str) -> tuple[bool, str]:
     """
     top, front = obs.after.get(TOP), obs.after.get(FRONT)
     if top is None or front is None or top.robot_base is None:
-        return False, "the calibrated top view and the front view are needed"
+        return False, Reason("missing_view", "the calibrated top view and the front view are needed")
     heights, mask = _heights(top), _mask(obs, top, a)
     if heights is None or not mask.any():
-        return False, f"{a} is not visible from the top (or the top view has no depth)"
+        return False, Reason("not_visible", f"{a} is not visible from the top (or the top view has no depth)")
     tall = mask & (heights > 0.5 * _highest(heights, mask))
     rows, cols = np.nonzero(tall)
     if len(rows) < 3:
-        return False, f"{a}'s upper part does not show from the top"
+        return False, Reason("not_visible", f"{a}'s upper part does not show from the top")
     spread, axes = np.linalg.eigh(np.cov(np.vstack([rows, cols])))
     if spread[1] < FACE_ELONGATION ** 2 * max(float(spread[0]), 1e-9):
-        return False, f"{a}'s upper part is not flat enough from the top to tell which way it faces"
+        return False, Reason("cannot_tell",
+                             f"{a}'s upper part is not flat enough from the top to tell which way it faces")
     to_robot = np.array(top.robot_base) - [rows.mean(), cols.mean()]
     off = float(np.arccos(min(1.0, abs(float(axes[:, 0] @ to_robot)) / float(np.linalg.norm(to_robot)))))
     if off > FACE_TOL:
-        return False, f"{a}'s face is turned {np.degrees(off):.0f} degrees from the robot (from the top)"
+        return False, Reason("turned_away", f"{a}'s face is turned {np.degrees(off):.0f} degrees from the "
+                             "robot (from the top)")
     seen = _mask(obs, front, a)
     front_rows = rows_of(seen)
     if front_rows is None:
-        return False, f"{a} is hidden from the front: which of its sides faces the robot cannot be seen"
+        return False, Reason("not_visible", f"{a} is hidden from the front: which of its sides faces the "
+                             "robot cannot be seen")
     upper = seen.copy()
     upper[front_rows[0] + int(0.6 * (front_rows[1] - front_rows[0])):] = False
     if upper.sum() < FACE_MIN_PX:
-        return False, f"too little of {a} shows from the front to tell which of its sides faces the robot"
+        return False, Reason("not_visible", f"too little of {a} shows from the front to tell which of its "
+                             "sides faces the robot")
     p10, p90 = np.percentile(front.rgb[upper].astype(float).mean(axis=1), [10, 90])
     contrast = float(p90 / max(p10, 1.0))
     if contrast > FACE_CONTRAST:
-        return False, (f"{a} shows its face to the front camera (contrast x{contrast:.1f}): it faces away "
-                       "from the robot")
+        return False, Reason("facing_away", f"{a} shows its face to the front camera (contrast "
+                             f"x{contrast:.1f}): it faces away from the robot")
     return True, f"faces the robot within {np.degrees(off):.0f} degrees, its plain back to the front camera"
 
 
@@ -251,14 +264,14 @@ def _hanging(obs: Observation, a: str, b: str) -> tuple[bool, str]:
     heights = _heights(top) if top is not None else None
     reach = _max_height(obs, a, any_way_up=True)
     if top is None or heights is None or reach is None:
-        return False, "the top view's heights and the object's type are needed"
+        return False, Reason("missing_view", "the top view's heights and the object's type are needed")
     ma, mb = _mask(obs, top, a), _mask(obs, top, b)
     if not ma.any() or not mb.any():
-        return False, f"{a} or {b} is not visible from the top"
+        return False, Reason("not_visible", f"{a} or {b} is not visible from the top")
     high = _highest(heights, ma)
     if high < reach + HANG_CLEAR:
-        return False, (f"{a}'s top is {100 * high:.1f} cm above the table, no higher than it reaches "
-                       f"resting any way up ({100 * reach:.1f} cm): it does not hang")
+        return False, Reason("too_low", f"{a}'s top is {100 * high:.1f} cm above the table, no higher than "
+                             f"it reaches resting any way up ({100 * reach:.1f} cm): it does not hang")
     if not touch(ma, mb):
-        return False, f"{a} does not touch {b} from the top: it does not hang from it"
+        return False, Reason("no_contact", f"{a} does not touch {b} from the top: it does not hang from it")
     return True, f"{a}'s top is {100 * high:.1f} cm above the table, touching {b}"

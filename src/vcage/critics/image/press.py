@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from vcage.critics.base import Observation, View
+from vcage.critics.base import Observation, Reason, View
 from vcage.critics.image.measure import _heights, _mask, _peak, _top_band, _touch_depth, _type_of
 from vcage.critics.image.thresholds import (
     BUTTON_COVER,
@@ -30,44 +30,47 @@ def _released(obs: Observation, a: str) -> tuple[bool, str]:
     """A held object touches the hand in every view; a projection overlap in one is not contact."""
     seen = {cam: view for cam, view in obs.after.items() if _mask(obs, view, a).any()}
     if not seen:  # hidden in every view: inside the hand, or gone; no view shows it let go
-        return False, f"{a} is not visible in any view after the subtask"
+        return False, Reason("not_visible", f"{a} is not visible in any view after the subtask")
     touching = [cam for cam, view in seen.items()
                 if touch(view.segmentation == ROBOT, _mask(obs, view, a), _touch_depth(view))]
     if touching and len(touching) == len(seen):
-        return False, f"the robot still touches {a} in the {' and '.join(touching)} views"
+        return False, Reason("still_touching",
+                             f"the robot still touches {a} in the {' and '.join(touching)} views")
     return True, "the robot is clear of it"
 
 
 def _pressed(obs: Observation, x: str) -> tuple[bool, str]:
     front, top = obs.during.get(FRONT), obs.during.get(TOP)
     if front is None or top is None:
-        return False, "no view of the press"
+        return False, Reason("missing_view", "no view of the press")
     mx_front = _mask(obs, front, x)
     hidden = False
     if not touch(front.segmentation == ROBOT, mx_front, front.depth):
         hidden = _contact_hidden(obs, front, x)
         if not hidden:
-            return False, f"the hand never touched {x}"
+            return False, Reason("no_contact", f"the hand never touched {x}")
     mx_top = _mask(obs, top, x)
     before = obs.before.get(TOP)
     if before is not None:  # the hand hides ``x`` from the top: use its outline from before
         mx_top = mx_top | _mask(obs, before, x)
     outline = hull(mx_top) if mx_top.any() else mx_top
     if not np.any(dilate(top.segmentation == ROBOT, TOUCH) & outline):
-        return False, f"the hand was not over {x}"
+        return False, Reason("not_over_target", f"the hand was not over {x}")
     cover, reading = _button_cover(obs, x), _press_depth(obs, x)
     if hidden and (cover is None or reading is None):
-        return False, f"an object in front hides where the hand met {x}, and the top view cannot measure it"
+        return False, Reason("cannot_tell", f"an object in front hides where the hand met {x}, and the top "
+                             "view cannot measure it")
     if cover is not None and cover < BUTTON_COVER:
-        return False, f"the hand covered {cover:.0%} of {x}'s top (its button) at its lowest"
+        return False, Reason("not_covered",
+                             f"the hand covered {cover:.0%} of {x}'s top (its button) at its lowest")
     if reading is not None:
         depth, full, share = reading
         if depth < share * full:
-            return False, (f"the hand stopped {1000 * (share * full - depth):.1f} mm short of pressing {x} "
-                           "down its travel")
+            return False, Reason("too_shallow", f"the hand stopped {1000 * (share * full - depth):.1f} mm "
+                                 f"short of pressing {x} down its travel")
         if depth > full + PRESS_ROOM:
-            return False, (f"the hand went {1000 * (depth - full):.1f} mm deeper than a full press of {x}: "
-                           f"{x} gave way under it (tipped, slid or fell)")
+            return False, Reason("too_deep", f"the hand went {1000 * (depth - full):.1f} mm deeper than a "
+                                 f"full press of {x}: {x} gave way under it (tipped, slid or fell)")
     return True, "the hand touched and covered it at its lowest"
 
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from vcage.critics.base import Observation, View
+from vcage.critics.base import Observation, Reason, View
 from vcage.critics.image.drawers import _in_drawer
 from vcage.critics.image.lying import _not_down, _on_its_side, _slanted_dome, _turned_over
 from vcage.critics.image.measure import (
@@ -46,15 +46,15 @@ def _rests_on(obs: Observation, a: str, b: str, inside: bool) -> tuple[bool, str
     top = obs.after.get(TOP)
     front = obs.after.get(FRONT)
     if top is None or front is None:
-        return False, "the top and front views are needed"
+        return False, Reason("missing_view", "the top and front views are needed")
     ma, mb = _mask(obs, top, a), _outline(obs, top, b)  # ``a`` may hide part of ``b`` now
     if not ma.any():
-        return False, f"{a} is not visible from the top"
+        return False, Reason("not_visible", f"{a} is not visible from the top")
     if _covered(obs, top, b):  # from the top ``b`` is (mostly) hidden: where it is, the front view says
         side = None if inside else _on_its_side(obs, top, a, b)  # a cup lying across a coaster hides it
         return (False, side) if side is not None else _front_support(obs, front, a, b)
     if not mb.any():
-        return False, f"{b} is not visible from the top"
+        return False, Reason("not_visible", f"{b} is not visible from the top")
     # which is smaller by hulls, not pixels: where ``a`` hid the middle of ``b`` before and hides it
     # now, ``b``'s outline is a ring with fewer pixels than ``a`` though ``b`` is the larger
     hull_a, hull_b = hull(ma), hull(mb)
@@ -62,9 +62,9 @@ def _rests_on(obs: Observation, a: str, b: str, inside: bool) -> tuple[bool, str
     overlap = float((small & big).sum() / small.sum())
     btype = _type_of(obs, b)
     if overlap < MIN_OVERLAP and not (btype is not None and btype.any_face):
-        return False, f"only {overlap:.0%} of {a} overlaps {b} from the top"
+        return False, Reason("not_over_target", f"only {overlap:.0%} of {a} overlaps {b} from the top")
     if not centroid_in(ma, mb, CENTRE_TOL):
-        return False, f"the centre of {a} is not over {b} from the top"
+        return False, Reason("not_over_target", f"the centre of {a} is not over {b} from the top")
     # in a container an object may lie any way up; on a surface, turned over it does not rest on its base
     other = _landed_on_other(obs, top, a, b, inside) or (
         None if inside else _turned_over(obs, top, a) or _slanted_dome(obs, top, a, b)
@@ -75,13 +75,13 @@ def _rests_on(obs: Observation, a: str, b: str, inside: bool) -> tuple[bool, str
     if fa is not None and fb is not None:
         a_bottom = fa[1]
         if a_bottom < fb[0] - ROW_TOL and not inside:
-            return False, f"{a} floats above {b} in the front view"
+            return False, Reason("floating", f"{a} floats above {b} in the front view")
         if a_bottom > fb[1] + ROW_TOL:
-            return False, f"{a} is below {b} in the front view"
+            return False, Reason("below_target", f"{a} is below {b} in the front view")
     return True, f"{overlap:.0%} overlap from the top"
 
 
-def _landed_on_other(obs: Observation, top: View, a: str, b: str, inside: bool) -> str | None:
+def _landed_on_other(obs: Observation, top: View, a: str, b: str, inside: bool) -> Reason | None:
     """Why ``a`` cannot rest on (in) ``b`` from the heights of the top view (None if they allow it).
 
     - ``a`` stands too high: an object resting on ``b`` has the top of its own axis (whose height
@@ -124,7 +124,7 @@ def _landed_on_other(obs: Observation, top: View, a: str, b: str, inside: bool) 
 
 
 def _on_rim(obs: Observation, top: View, a: str, b: str,
-            lean: tuple[np.ndarray, np.ndarray, float] | None = None) -> str | None:
+            lean: tuple[np.ndarray, np.ndarray, float] | None = None) -> Reason | None:
     """Why ``a`` lies on ``b``'s rim rather than in it (None if it does not, or the views cannot
     tell). ``a`` lies as it lay before (its top-view area kept), so its underside is its own height
     under its top; before the subtask ``a`` stood on the table (the outline around it there), where
@@ -152,7 +152,8 @@ def _on_rim(obs: Observation, top: View, a: str, b: str,
         under = rim - (_highest(ha, now) - own)
     if under < RIM_GAP:
         where = f"{100 * under:.1f} cm under" if under >= 0 else f"{-100 * under:.1f} cm above"
-        return f"{a}'s underside is {where} {b}'s rim: it rests on the rim or on something, not down in {b}"
+        return Reason("on_rim", f"{a}'s underside is {where} {b}'s rim: it rests on the rim or on something, "
+                      f"not down in {b}")
     return None
 
 
@@ -160,13 +161,13 @@ def _front_support(obs: Observation, front: View, a: str, b: str) -> tuple[bool,
     """In the front view ``a`` lies above ``b``, over its columns, touching it at the same depth."""
     fa, fb = _mask(obs, front, a), _mask(obs, front, b)
     if not fa.any() or not fb.any():
-        return False, f"{b} is hidden from the top and {a} or {b} from the front"
+        return False, Reason("not_visible", f"{b} is hidden from the top and {a} or {b} from the front")
     ca, cb = np.nonzero(fa.any(axis=0))[0], np.nonzero(fb.any(axis=0))[0]
     shared = min(ca[-1], cb[-1]) - max(ca[0], cb[0]) + 1
     if shared < MIN_OVERLAP * min(len(ca), len(cb)):
-        return False, f"{a} is not over {b} in the front view"
+        return False, Reason("not_over_target", f"{a} is not over {b} in the front view")
     if np.nonzero(fa)[0].mean() >= np.nonzero(fb)[0].mean() or not touch(fa, fb, front.depth):
-        return False, f"{a} does not rest on {b} in the front view"
+        return False, Reason("not_resting", f"{a} does not rest on {b} in the front view")
     return True, f"{b} is hidden from the top; {a} rests on it in the front view"
 
 
@@ -186,7 +187,7 @@ def _inside(obs: Observation, a: str, b: str) -> tuple[bool, str]:
     return _in_drawer(obs, a, b, drawer)
 
 
-def _off_centre(obs: Observation, a: str, b: str) -> str | None:
+def _off_centre(obs: Observation, a: str, b: str) -> Reason | None:
     """Why ``a`` lies too near ``b``'s outline, in the top view after the subtask, to be in ``b``
     (None if it does not, or the views or types cannot tell). The oracle wants ``a``'s centre of
     mass over ``b``'s region, which lies in from ``b``'s outline by at least ``b``'s size less the
@@ -220,8 +221,8 @@ def _off_centre(obs: Observation, a: str, b: str) -> str | None:
     if depth >= need:
         return None
     where = f"{100 * depth:.1f} cm in from" if depth >= 0 else f"{-100 * depth:.1f} cm outside"
-    return (f"{what} lies {where} {b}'s outline, where in {b} it would lie at least {100 * need:.1f} cm "
-            f"in: it lies across {b}'s wall or outside it")
+    return Reason("across_wall", f"{what} lies {where} {b}'s outline, where in {b} it would lie at least "
+                  f"{100 * need:.1f} cm in: it lies across {b}'s wall or outside it")
 
 
 def _stacked(obs: Observation, *objs: str) -> tuple[bool, str]:
