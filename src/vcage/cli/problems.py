@@ -10,7 +10,7 @@ from rich.text import Text
 from vcage.cli._app import console
 
 if TYPE_CHECKING:
-    from vcage.data.verify import VerifyReport
+    from vcage.data.verify_report import VerifyReport
 
 
 def print_problems(report: VerifyReport) -> None:

@@ -47,7 +47,8 @@ from vcage.data.files import (
     write_text,
 )
 from vcage.data.reader import NPZ_ERRORS, load_json, load_npz, read_parquet
-from vcage.data.verify import Scan, VerifyReport, span
+from vcage.data.scan import Scan
+from vcage.data.verify_report import VerifyReport, span
 from vcage.errors import DatasetError
 
 # (an episode's extras, its stored simulator states) -> the frames of each camera, by feature key
