@@ -66,3 +66,13 @@ def test_plans_and_critics_load_no_simulator() -> None:
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
     assert done.returncode == 0, done.stderr
     assert done.stdout.strip() == "[]"
+
+
+MODULE_LINES = 400  # a module past this holds more than one concept: split it (docs/ARCHITECTURE.md)
+
+
+def test_no_module_is_longer_than_the_limit() -> None:
+    root = Path(vcage.__file__).parent
+    long = {str(p.relative_to(root)): n for p in sorted(root.rglob("*.py"))
+            if (n := len(p.read_text().splitlines())) > MODULE_LINES}
+    assert not long, f"modules over {MODULE_LINES} lines: {long}"
