@@ -9,7 +9,7 @@ import pytest
 
 from vcage.assets.catalog import CATALOG
 from vcage.critics.image.measure import _heights
-from vcage.critics.image.thresholds import FINGER_CONTACT, HAND_TOP, PRESS_SHARE
+from vcage.critics.image.thresholds import DEFAULT
 from vcage.pipeline.verifier import render_views
 from vcage.scene.compose import compose
 from vcage.scene.spec import ObjectSpec, SceneSpec
@@ -17,6 +17,8 @@ from vcage.sim.render import ROBOT, Renderer
 from vcage.skills.base import Skills
 from vcage.skills.faults import FaultConfig, FaultInjector
 from vcage.skills.playback import Player
+
+FINGER_CONTACT, HAND_TOP, PRESS_SHARE = DEFAULT.FINGER_CONTACT, DEFAULT.HAND_TOP, DEFAULT.PRESS_SHARE
 
 # (type, yaw, x, y, the seed of a light press the oracle does not count: a lever pressed "lightly"
 # can still go past the oracle's travel)

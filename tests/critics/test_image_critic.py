@@ -10,7 +10,7 @@ import pytest
 
 from vcage.critics.base import Observation, View
 from vcage.critics.image import ImageCritic
-from vcage.critics.image.thresholds import TURNS
+from vcage.critics.image.thresholds import DEFAULT
 from vcage.critics.masks import best_move, inward, moved
 from vcage.pipeline.verifier import render_views
 from vcage.planning.goals import put_at, put_on
@@ -259,7 +259,7 @@ def test_an_outline_is_followed_through_a_turn_as_well_as_a_slide() -> None:
     before[40:60, 30:70] = True  # 20 by 40 pixels
     rows, cols = np.nonzero(before)
     now = moved(before, (24.0, float(rows.mean()), float(cols.mean()), 30, 50))
-    move = best_move(before, now, TURNS)
+    move = best_move(before, now, DEFAULT.TURNS)
     assert move[0] == 24.0 and move[3:] == (30, 50)
     assert (moved(before, move) == now).all()
     slid = best_move(before, now, (0.0,))
@@ -288,10 +288,12 @@ def test_the_critics_version_changes_with_any_rule_and_its_thresholds_are_record
     assert package <= {p.name for p in files} and "masks.py" in {p.name for p in files}
     assert ImageCritic().version() == f"image@{image.rules_digest()}"
     changed = tmp_path / "thresholds.py"
-    changed.write_text(Path(thresholds.__file__).read_text().replace("NEAR = 0.1", "NEAR = 0.12"))
+    source = Path(thresholds.__file__).read_text()
+    changed.write_text(source.replace("NEAR: float = 0.1 ", "NEAR: float = 0.12 "))
     assert changed.read_text() != Path(thresholds.__file__).read_text()
     swapped = [changed if p.name == "thresholds.py" else p for p in files]
     assert image.rules_digest(swapped) != image.rules_digest()
     rules = ImageCritic().rules()
-    assert rules["NEAR"] == thresholds.NEAR and rules["BUTTON_PX"] == list(thresholds.BUTTON_PX)
+    default = thresholds.DEFAULT
+    assert rules["NEAR"] == default.NEAR and rules["BUTTON_PX"] == list(default.BUTTON_PX)
     assert json.loads(json.dumps(rules)) == rules  # stored as JSON in the runs log

@@ -7,8 +7,10 @@ which only the oracle critic reads.
 
 from __future__ import annotations
 
+import copy
+import json
 from abc import ABC, abstractmethod
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -16,6 +18,7 @@ import numpy as np
 
 from vcage.backends import BackendConfig
 from vcage.config import from_fields
+from vcage.critics.image.thresholds import overridden, values
 from vcage.errors import ConfigError
 from vcage.planning.schema import Subtask
 from vcage.registry import Registry
@@ -127,7 +130,9 @@ class CriticConfig:
     ``VCAGE_VLM_*`` environment variables are read once, when the run's configuration is resolved,
     and the result is stored with the dataset like any other option. ``votes``, ``rule`` and
     ``malformed_verdict`` apply to the ``vlm`` critic: how many times it is asked, how the answers
-    combine (``majority`` or ``all``), and what an unusable answer counts as.
+    combine (``majority`` or ``all``), and what an unusable answer counts as. ``thresholds`` apply to
+    the ``image`` critic: its thresholds by name (:mod:`vcage.critics.image.thresholds`) in place of
+    their defaults, kept as JSON values; stored only when some are given.
     """
 
     name: str = "image"
@@ -135,17 +140,30 @@ class CriticConfig:
     votes: int = 1
     rule: str = "majority"
     malformed_verdict: bool = False
+    thresholds: dict[str, Any] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         CRITICS.get(self.name)  # an unknown name lists the valid ones
+        if not isinstance(self.thresholds, Mapping):
+            raise ConfigError(f"critic thresholds must map names to values, got {self.thresholds!r}")
+        if self.thresholds and self.name != "image":
+            raise ConfigError(f"critic thresholds apply to the image critic, not to {self.name!r}")
+        given = values(overridden(self.thresholds))  # refuses an unknown name or a value not of its kind
+        object.__setattr__(self, "thresholds", {name: given[name] for name in self.thresholds})
         if isinstance(self.votes, bool) or not isinstance(self.votes, int) or self.votes < 1:
             raise ConfigError(f"critic votes must be an integer >= 1, got {self.votes!r}")
         if self.rule not in ("majority", "all"):
             raise ConfigError(f"critic rule {self.rule!r}; valid: majority, all")
 
     def to_dict(self) -> dict[str, Any]:
-        return {"name": self.name, "backend": self.backend.to_dict() if self.backend else None,
+        data = {"name": self.name, "backend": self.backend.to_dict() if self.backend else None,
                 "votes": self.votes, "rule": self.rule, "malformed_verdict": self.malformed_verdict}
+        if self.thresholds:  # a configuration with the defaults is stored as before the field existed
+            data["thresholds"] = copy.deepcopy(self.thresholds)
+        return data
+
+    def __hash__(self) -> int:  # hashable as before ``thresholds`` (a dict) existed
+        return hash(json.dumps(self.to_dict(), sort_keys=True))
 
     @classmethod
     def from_dict(cls, data: dict[str, Any]) -> CriticConfig:

@@ -84,7 +84,8 @@ from __future__ import annotations
 
 import functools
 import hashlib
-from collections.abc import Callable, Sequence
+import json
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -114,13 +115,25 @@ def rules_digest(files: Sequence[Path] | None = None) -> str:
 
 
 class ImageCritic(Critic):
+    """``overrides``: thresholds by name (``CriticConfig.thresholds``) in place of their defaults
+    (:mod:`~vcage.critics.image.thresholds`); the checks read them while this critic judges."""
+
     name = "image"
 
+    def __init__(self, overrides: Mapping[str, Any] | None = None) -> None:
+        self.thresholds = thresholds.overridden(overrides or {})
+
     def version(self) -> str:
-        return f"image@{_DIGEST()}"
+        """``image@<rules digest>``, followed by ``+<digest>`` of the thresholds that differ from the
+        defaults where some do."""
+        changed = thresholds.changed(self.thresholds)
+        if not changed:
+            return f"image@{_DIGEST()}"
+        digest = hashlib.sha256(json.dumps(changed, sort_keys=True).encode()).hexdigest()[:12]
+        return f"image@{_DIGEST()}+{digest}"
 
     def rules(self) -> dict[str, Any]:
-        return thresholds.values()
+        return thresholds.values(self.thresholds)
 
     def judge(self, obs: Observation) -> Verdict:
         """Every predicate's check; a rejection's ``codes`` name each failed predicate with its
@@ -129,12 +142,13 @@ class ImageCritic(Critic):
         checks: dict[str, bool] = {}
         reasons: list[str] = []
         codes: list[str] = []
-        for pred in obs.subtask.predicates:
-            ok, why = IMAGE_CHECKS.get(pred.name)(obs, *pred.args)
-            checks[str(pred)] = ok
-            if not ok:
-                reasons.append(f"{pred}: {why}")
-                codes.append(f"{pred.name}.{why.code if isinstance(why, Reason) else UNSPECIFIED}")
+        with thresholds.using(self.thresholds):
+            for pred in obs.subtask.predicates:
+                ok, why = IMAGE_CHECKS.get(pred.name)(obs, *pred.args)
+                checks[str(pred)] = ok
+                if not ok:
+                    reasons.append(f"{pred}: {why}")
+                    codes.append(f"{pred.name}.{why.code if isinstance(why, Reason) else UNSPECIFIED}")
         accept = not reasons
         reason = "; ".join(reasons) if reasons else "all image checks pass"
         return Verdict(accept, reason, {"checks": checks}, tuple(codes))
@@ -156,7 +170,7 @@ for _name, _check in _checks.items():
 
 @CRITICS.register("image")
 def _image(config: CriticConfig) -> Critic:
-    return ImageCritic()
+    return ImageCritic(config.thresholds)
 
 
 _DIGEST = functools.cache(rules_digest)

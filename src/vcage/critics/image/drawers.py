@@ -5,15 +5,7 @@ from __future__ import annotations
 from vcage.assets.annotations import Placement
 from vcage.critics.base import Observation, Reason
 from vcage.critics.image.measure import _heights, _hidden, _highest, _mask, _scale, _type_of
-from vcage.critics.image.thresholds import (
-    FLOOR_TOL,
-    IN_DRAWER,
-    MIN_RELIEF_PX,
-    OPEN_MARGIN,
-    SHUT_OUT,
-    TOP,
-    TOP_BAND_BODY,
-)
+from vcage.critics.image.thresholds import TOP, active
 from vcage.critics.masks import (
     dilate,
     rectangle_sides,
@@ -37,7 +29,7 @@ def _drawer(obs: Observation, x: str) -> tuple[float, float, bool] | Reason:
     if point is None:
         return Reason("no_drawer", f"{x} ({otype.name}) has no drawer")
     heights, mask = _heights(after), _mask(obs, after, x)
-    if heights is None or after.pixel_size is None or mask.sum() < MIN_RELIEF_PX:
+    if heights is None or after.pixel_size is None or mask.sum() < active().MIN_RELIEF_PX:
         return Reason("not_visible", f"{x} is not seen in the top view's heights")
     scale = _scale(otype, heights, mask)
     long, short = rectangle_sides(mask)
@@ -66,9 +58,9 @@ def _in_drawer(obs: Observation, a: str, b: str, place: Placement) -> tuple[bool
         return False, Reason("drawer_not_open",
                              f"{b}'s drawer is not open after the subtask, so {a} cannot be seen in it")
     top = _highest(hb, mb)
-    body = mb & (hb >= top - TOP_BAND_BODY)
+    body = mb & (hb >= top - active().TOP_BAND_BODY)
     share = float((ma & dilate(mb & ~body, 1)).sum() / ma.sum())
-    if share < IN_DRAWER:
+    if share < active().IN_DRAWER:
         return False, Reason("not_over_target",
                              f"only {share:.0%} of {a} lies over {b}'s open drawer from the top")
     scale = _scale(otype, hb, mb)
@@ -81,7 +73,7 @@ def _in_drawer(obs: Observation, a: str, b: str, place: Placement) -> tuple[bool
     atype = _type_of(obs, a)
     if atype is not None:
         a_top = _highest(ha, ma)
-        least = floor + atype.size[2] * atype.scale_range[0] - FLOOR_TOL
+        least = floor + atype.size[2] * atype.scale_range[0] - active().FLOOR_TOL
         if a_top < least:
             return False, Reason("too_low", f"{a}'s top is {100 * (least - a_top):.1f} cm lower than lying "
                                  f"on the floor of {b}'s drawer makes it: {a} lies beside the drawer")
@@ -93,10 +85,10 @@ def _opened(obs: Observation, x: str) -> tuple[bool, str]:
     if isinstance(drawer, str):
         return False, drawer
     out, travel, hidden = drawer
-    if out >= travel + OPEN_MARGIN:
+    if out >= travel + active().OPEN_MARGIN:
         return True, "opened"
     why = (f"{x}'s drawer is out about {100 * out:.1f} cm in the top view, less than the "
-           f"{100 * (travel + OPEN_MARGIN):.0f} cm that count as open")
+           f"{100 * (travel + active().OPEN_MARGIN):.0f} cm that count as open")
     return False, Reason("drawer_not_open", why + (" (the robot hides part of it)" if hidden else ""))
 
 
@@ -108,7 +100,7 @@ def _closed(obs: Observation, x: str) -> tuple[bool, str]:
     if hidden:
         return False, Reason("robot_hides",
                              f"the robot hides part of {x} in the top view: its drawer may stand out")
-    if out > SHUT_OUT:
+    if out > active().SHUT_OUT:
         return False, Reason("drawer_not_shut",
                              f"{x}'s drawer is out about {100 * out:.1f} cm in the top view, not shut")
     return True, "closed"

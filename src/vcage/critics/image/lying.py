@@ -22,26 +22,7 @@ from vcage.critics.image.measure import (
     _surface,
     _type_of,
 )
-from vcage.critics.image.thresholds import (
-    BARE,
-    CURVED,
-    DEEP,
-    DOME_SLOPE,
-    FLAT_TOP,
-    HEIGHT_TOL,
-    HOLLOW_PERCENTILE,
-    MIN_OVERLAP,
-    SIDE_GAP,
-    STILL,
-    SUPPORT_TOL,
-    THIN_SUPPORT,
-    TOP,
-    TOP_TOL,
-    TURNS,
-    TYPE_FLAT,
-    UNDER_PX,
-    UPRIGHT_TOL,
-)
+from vcage.critics.image.thresholds import BARE, TOP, active
 from vcage.critics.masks import (
     TOUCH,
     Move,
@@ -80,7 +61,7 @@ def _on_its_side(obs: Observation, top: View, a: str, b: str) -> Reason | None:
                       f"to its lowest, lying on its side at most {100 * radius:.1f} cm): it lies on its side")
     standing, lying = _standing_and_lying(obs, otype, before, a)
     surface = _surface(obs, b, _peak(hb, mb))
-    if standing - lying < SIDE_GAP or surface is None:
+    if standing - lying < active().SIDE_GAP or surface is None:
         return None
     high = float(np.percentile(ha[now], 95)) - surface
     if high < (standing + lying) / 2:
@@ -105,9 +86,10 @@ def _inside_fall(otype: ObjectType, top: View, mask: np.ndarray,
     lo, hi = otype.scale_range
     radius = min(otype.size[0], otype.size[1]) / 2 * hi
     depth = (otype.size[2] - otype.placements[0].pos[2]) * lo
-    if depth < DEEP * radius or not _shows_most(otype, top, mask):
+    if depth < active().DEEP * radius or not _shows_most(otype, top, mask):
         return None
-    drop = _highest(heights, mask, rim=True) - float(np.percentile(heights[_inner(mask)], HOLLOW_PERCENTILE))
+    lowest = float(np.percentile(heights[_inner(mask)], active().HOLLOW_PERCENTILE))
+    drop = _highest(heights, mask, rim=True) - lowest
     return drop, radius
 
 
@@ -121,8 +103,9 @@ def _standing_and_lying(obs: Observation, otype: ObjectType, before: View, a: st
     lo, hi = otype.scale_range
     across = max(otype.size[0], otype.size[1])
     own = _own_height(obs, a, outline=True)
+    tol = active().UPRIGHT_TOL
     if (own is not None and _on_its_base(otype, before, _mask(obs, before, a))
-            and otype.size[2] * lo - UPRIGHT_TOL <= own <= otype.size[2] * hi + UPRIGHT_TOL):
+            and otype.size[2] * lo - tol <= own <= otype.size[2] * hi + tol):
         return own, across * own / otype.size[2]
     return otype.size[2] * lo, across * hi
 
@@ -147,11 +130,11 @@ def _not_down(obs: Observation, top: View, a: str, surface: float | None, floor:
     too_tall = None  # said after the clutter under ``a``, which says more
     if surface is not None and height is not None:
         above = float(ha[ma].min()) - height - surface
-        if above > HEIGHT_TOL:
+        if above > active().HEIGHT_TOL:
             return Reason("too_high",
                           f"{a} stands {100 * above:.1f} cm higher than resting on {where} allows")
         taller = _highest(ha, ma, rim=_open(_type_of(obs, a))) - height - surface
-        if standing and taller > TOP_TOL:
+        if standing and taller > active().TOP_TOL:
             too_tall = Reason("too_tall", f"{a}'s top is {100 * taller:.1f} cm higher than {a} standing on "
                               f"{where} reaches")
     surface = floor if surface is None else surface
@@ -160,7 +143,7 @@ def _not_down(obs: Observation, top: View, a: str, surface: float | None, floor:
         if c in skip or not was.any():
             continue
         now = top.segmentation == i
-        pushed = now.any() and (now & dilate(was, TOUCH)).sum() < STILL * now.sum()
+        pushed = now.any() and (now & dilate(was, TOUCH)).sum() < active().STILL * now.sum()
         move: Move = (0.0, 0.0, 0.0, *(best_shift(was, now) if pushed else (0, 0)))  # pushed: follow it
         outline = moved(was, move)
         bare_a = ma & ~dilate(now, 1)  # what of ``a`` does not border what shows of ``c``
@@ -168,18 +151,20 @@ def _not_down(obs: Observation, top: View, a: str, surface: float | None, floor:
         # where ``c`` stayed, ``a`` hides of it what it no longer shows: nudged a pixel or two (not
         # followed), it still shows all of itself, and the sliver of its outline under ``a`` is not ``c``
         hidden = int(under.sum()) if pushed else min(int(under.sum()), int(was.sum()) - int(now.sum()))
-        if pushed and hidden >= UNDER_PX:  # it may have turned as it went: a slid outline overhangs it
-            move = best_move(was, now, TURNS)
+        # it may have turned as it went: a slid outline overhangs it
+        if pushed and hidden >= active().UNDER_PX:
+            move = best_move(was, now, active().TURNS)
             outline = moved(was, move)
             under = outline & bare_a
             hidden = int(under.sum())
-        if hidden < UNDER_PX:
+        if hidden < active().UNDER_PX:
             continue
         beside = outline & ~dilate(ma, 1)  # where ``c`` would show if it still lay under ``a``
         if (beside & (top.segmentation == BARE)).sum() > beside.sum() / 2:
             continue  # the table shows there: ``c`` is gone (knocked off, out of sight)
         rise = float(np.median(moved(np.where(was, hb, 0.0), move)[under])) - surface
-        if rise > SUPPORT_TOL or (rise > THIN_SUPPORT and under.sum() >= MIN_OVERLAP * ma.sum()):
+        t = active()
+        if rise > t.SUPPORT_TOL or (rise > t.THIN_SUPPORT and under.sum() >= t.MIN_OVERLAP * ma.sum()):
             return Reason("on_other_object",
                           f"{a} lies over {c}, whose top is {100 * rise:.1f} cm above {where}")
     return too_tall
@@ -199,11 +184,12 @@ def _turned_over(obs: Observation, top: View, a: str) -> Reason | None:
     if otype is None or before is None or before.pixel_size is None or _open(otype) or otype.any_face:
         return None
     now = _relief(top, _mask(obs, top, a))
-    flat = TYPE_FLAT * otype.top_relief * otype.scale_range[0]
+    share = active().TYPE_FLAT
+    flat = share * otype.top_relief * otype.scale_range[0]
     why = _flatter_than_before(obs, a, otype, before, now)
     if why is None and now is not None and now < flat:
         return Reason("turned_over", f"{a}'s top is flat ({1000 * now:.1f} mm from a plane; {otype.name} "
-                      f"standing shows at least {1000 * flat / TYPE_FLAT:.1f} mm): it lies turned over")
+                      f"standing shows at least {1000 * flat / share:.1f} mm): it lies turned over")
     return why
 
 
@@ -223,7 +209,7 @@ def _slanted_dome(obs: Observation, top: View, a: str, b: str) -> Reason | None:
     if fit is None or not _shows_most(otype, top, mask):
         return None
     ramp = btype.placements[0].slope if btype is not None and btype.placements else 0.0
-    bound = float(np.tan(ramp)) + DOME_SLOPE
+    bound = float(np.tan(ramp)) + active().DOME_SLOPE
     if fit[2] <= bound:
         return None
     return Reason("tilted", f"{a}'s domed top slopes {fit[2]:.2f} (rise over run), where standing on its "
@@ -237,9 +223,9 @@ def _flatter_than_before(obs: Observation, a: str, otype: ObjectType, before: Vi
     if not _on_its_base(otype, before, mask):
         return None  # not standing on its base before (a tilted block shows a side: two faces, no plane)
     was = _relief(before, mask)
-    if was is None or now is None or was < CURVED:
+    if was is None or now is None or was < active().CURVED:
         return None
-    if now < FLAT_TOP * was:
+    if now < active().FLAT_TOP * was:
         return Reason("turned_over", f"{a}'s top is flat now ({1000 * now:.1f} mm from a plane, "
                       f"{1000 * was:.1f} mm before): it lies turned over")
     return None

@@ -7,19 +7,7 @@ import numpy as np
 
 from vcage.assets.catalog import CATALOG, ObjectType
 from vcage.critics.base import Observation, View
-from vcage.critics.image.thresholds import (
-    BARE,
-    COVERED,
-    FOOTPRINT,
-    HEIGHT_TOL,
-    MIN_RELIEF_PX,
-    ROBOT,
-    SPIKE,
-    STILL,
-    TOP,
-    TOP_BAND,
-    UNDER_PX,
-)
+from vcage.critics.image.thresholds import BARE, ROBOT, TOP, active
 from vcage.critics.masks import (
     TOUCH,
     best_shift,
@@ -49,7 +37,7 @@ def _outline(obs: Observation, view: View, name: str) -> np.ndarray:
     before = _mask(obs, before_view, name)
     if not before.any() or not now.any():
         return now | before
-    if (now & dilate(before, TOUCH)).sum() >= STILL * now.sum():  # it did not move
+    if (now & dilate(before, TOUCH)).sum() >= active().STILL * now.sum():  # it did not move
         return now | before
     return now | shift(before, *best_shift(before, now))
 
@@ -65,7 +53,7 @@ def _own_height(obs: Observation, a: str, outline: bool = False) -> float | None
         return None
     was = _mask(obs, before, a)
     ring = dilate(was, 2) & ~dilate(was, 1) & (before.segmentation == BARE)
-    if not was.any() or ring.sum() < UNDER_PX or float(np.median(hb[ring])) > HEIGHT_TOL:
+    if not was.any() or ring.sum() < active().UNDER_PX or float(np.median(hb[ring])) > active().HEIGHT_TOL:
         return None
     return _highest(hb, was, rim=outline)
 
@@ -80,7 +68,7 @@ def _top_heights(view: View, mask: np.ndarray) -> tuple[np.ndarray, np.ndarray, 
     """The heights of ``mask``'s inner pixels in an orthographic view with depth and their rows and
     columns about their mean; None with fewer than :data:`MIN_RELIEF_PX` of them."""
     heights, inner = _heights(view), _inner(mask)
-    if heights is None or view.pixel_size is None or inner.sum() < MIN_RELIEF_PX:
+    if heights is None or view.pixel_size is None or inner.sum() < active().MIN_RELIEF_PX:
         return None
     rows, cols = np.nonzero(inner)
     return heights[inner], rows - rows.mean(), cols - cols.mean()
@@ -112,7 +100,7 @@ def _on_its_base(otype: ObjectType, view: View, mask: np.ndarray) -> bool:
         return False
     lo, hi = otype.scale_range
     share = mask.sum() * view.pixel_size ** 2 / (otype.size[0] * otype.size[1])
-    return bool(FOOTPRINT[0] * lo ** 2 <= share <= FOOTPRINT[1] * hi ** 2)
+    return bool(active().FOOTPRINT[0] * lo ** 2 <= share <= active().FOOTPRINT[1] * hi ** 2)
 
 
 def _shows_most(otype: ObjectType, view: View, mask: np.ndarray) -> bool:
@@ -122,7 +110,7 @@ def _shows_most(otype: ObjectType, view: View, mask: np.ndarray) -> bool:
     if view.pixel_size is None:
         return False
     footprint = otype.size[0] * otype.size[1] * otype.scale_range[0] ** 2
-    return bool(mask.sum() * view.pixel_size ** 2 >= FOOTPRINT[0] * footprint)
+    return bool(mask.sum() * view.pixel_size ** 2 >= active().FOOTPRINT[0] * footprint)
 
 
 def _surface(obs: Observation, b: str, top: float) -> float | None:
@@ -156,9 +144,9 @@ def _covered(obs: Observation, top: View, b: str) -> bool:
     if before is None:
         return False
     was, now = _mask(obs, before, b), _mask(obs, top, b)
-    if now.sum() >= COVERED * was.sum():
+    if now.sum() >= active().COVERED * was.sum():
         return False
-    return not now.any() or (now & dilate(was, TOUCH)).sum() < STILL * now.sum()
+    return not now.any() or (now & dilate(was, TOUCH)).sum() < active().STILL * now.sum()
 
 
 def _touch_depth(view: View) -> np.ndarray | None:
@@ -210,14 +198,14 @@ def _peak(heights: np.ndarray, mask: np.ndarray) -> float:
     rows, cols = h.shape
     around = np.max([padded[1 + dy:1 + dy + rows, 1 + dx:1 + dx + cols]
                      for dy in (-1, 0, 1) for dx in (-1, 0, 1) if dy or dx], axis=0)
-    kept = inner & (around >= h - SPIKE)
+    kept = inner & (around >= h - active().SPIKE)
     return float(h[kept if kept.any() else inner].max())
 
 
 def _top_band(heights: np.ndarray, mask: np.ndarray) -> np.ndarray:
     """``mask``'s top in a top view's ``heights``: its pixels within :data:`TOP_BAND` of its highest
     point (see :func:`_peak`), where a button or lever is."""
-    return mask & (heights >= _peak(heights, mask) - TOP_BAND)
+    return mask & (heights >= _peak(heights, mask) - active().TOP_BAND)
 
 
 def _hidden(view: View, mask: np.ndarray) -> int:

@@ -18,26 +18,7 @@ from vcage.critics.image.measure import (
     _type_of,
 )
 from vcage.critics.image.press import _released
-from vcage.critics.image.thresholds import (
-    AREA_RATIO,
-    BUTTON_PX,
-    COL_MARGIN,
-    FACE_CONTRAST,
-    FACE_ELONGATION,
-    FACE_MIN_PX,
-    FACE_TOL,
-    FRONT,
-    HANG_CLEAR,
-    HEIGHT_RATIO,
-    LIFT_ROWS,
-    MIN_OVERLAP,
-    NEAR,
-    SHAPE_RATIO,
-    TOP,
-    UPRIGHT_TILT,
-    UPRIGHT_TOL,
-    WHOLE_BASE,
-)
+from vcage.critics.image.thresholds import FRONT, TOP, active
 from vcage.critics.masks import (
     hull,
     rows_of,
@@ -57,18 +38,19 @@ def _upright(obs: Observation, x: str) -> tuple[bool, str]:
     hid_b, hid_a = _hidden(before, mb), _hidden(after, ma)
     area_b, area_a = int(mb.sum()), int(ma.sum())
     if area_b:  # the robot hides at most about the pixels it covers around the outline
-        if area_a > AREA_RATIO[1] * (area_b + hid_b) or area_a + hid_a < AREA_RATIO[0] * area_b:
+        low, high = active().AREA_RATIO
+        if area_a > high * (area_b + hid_b) or area_a + hid_a < low * area_b:
             return False, Reason("area_changed",
                                  f"{x}'s top-view area changed by x{area_a / area_b:.2f} (tipped over?)")
         if not hid_a and not hid_b and area_a:
             axes = spread(ma)[-1] / max(1e-9, spread(mb)[-1])
-            if not 1 / SHAPE_RATIO <= axes <= SHAPE_RATIO:
+            if not 1 / active().SHAPE_RATIO <= axes <= active().SHAPE_RATIO:
                 return False, Reason("shape_changed",
                                      f"{x}'s top-view outline stretched by x{axes:.2f} (tipped over?)")
     hb, ha = _heights(before), _heights(after)
     if hb is not None and ha is not None and mb.any() and ma.any():  # its highest point, from the top
         was, now = (_highest(h, m) for h, m in ((hb, mb), (ha, ma)))
-        if now < HEIGHT_RATIO * was:
+        if now < active().HEIGHT_RATIO * was:
             return False, Reason("lower_than_before", f"{x}'s top stands x{now / max(was, 1e-9):.2f} as high "
                                  "as before (tipped over?)")
         off = _off_height(obs, after, x, now) or _tipped_axis(obs, after, x)
@@ -78,7 +60,7 @@ def _upright(obs: Observation, x: str) -> tuple[bool, str]:
     # without the top view's depth, its height in the front view (which a thin object turned about
     # the vertical changes too: a board's plate seen edge-on, its top edge runs away from the camera)
     rb, ra = rows_of(_mask(obs, fb, x)), rows_of(_mask(obs, fa, x))
-    if rb and ra and (ra[1] - ra[0] + 1) < HEIGHT_RATIO * (rb[1] - rb[0] + 1):
+    if rb and ra and (ra[1] - ra[0] + 1) < active().HEIGHT_RATIO * (rb[1] - rb[0] + 1):
         return False, Reason("lower_than_before",
                              f"{x} looks lower in the front view than before (tipped over?)")
     return True, "upright"
@@ -94,7 +76,7 @@ def _off_height(obs: Observation, top: View, x: str, high: float) -> Reason | No
     otype = _type_of(obs, x)
     if otype is None or _open(otype):
         return None
-    if high > otype.size[2] * otype.scale_range[1] + UPRIGHT_TOL \
+    if high > otype.size[2] * otype.scale_range[1] + active().UPRIGHT_TOL \
             and _not_down(obs, top, x, None, 0.0, "the table", (x,)) is None:
         return Reason("too_tall", f"{x}'s top is {100 * high:.1f} cm above the table, higher than {x} "
                       "standing reaches (tipped?)")
@@ -123,18 +105,18 @@ def _tipped_axis(obs: Observation, top: View, x: str) -> Reason | None:
         return None
     lo = otype.scale_range[0]
     outline = hull(mask)
-    if outline.sum() * top.pixel_size ** 2 < WHOLE_BASE * np.pi * (otype.size[0] / 2 * lo) ** 2:
+    if outline.sum() * top.pixel_size ** 2 < active().WHOLE_BASE * np.pi * (otype.size[0] / 2 * lo) ** 2:
         return None
     patch = _top_band(heights, mask)
-    if not BUTTON_PX[0] <= patch.sum() <= BUTTON_PX[1]:
+    if not active().BUTTON_PX[0] <= patch.sum() <= active().BUTTON_PX[1]:
         return None
     (r, c), (rc, cc) = np.argwhere(patch).mean(axis=0), np.argwhere(outline).mean(axis=0)
     off = float(np.hypot(r - rc, c - cc)) * top.pixel_size
-    bound = float(np.sin(UPRIGHT_TILT)) * point.pos[2] * lo
+    bound = float(np.sin(active().UPRIGHT_TILT)) * point.pos[2] * lo
     if off <= bound:
         return None
     return Reason("tilted", f"{x}'s {point.name} lies {100 * off:.1f} cm off the centre of its base from the "
-                  f"top, where standing within {UPRIGHT_TILT} rad of upright it lies at most "
+                  f"top, where standing within {active().UPRIGHT_TILT} rad of upright it lies at most "
                   f"{100 * bound:.1f} cm off: it tilts")
 
 
@@ -152,7 +134,7 @@ def _on_table(obs: Observation, a: str) -> tuple[bool, str]:
         if other == a:
             continue
         mo = top.segmentation == i
-        if mo.sum() > ma.sum() and (ma & hull(mo)).sum() > MIN_OVERLAP * ma.sum():
+        if mo.sum() > ma.sum() and (ma & hull(mo)).sum() > active().MIN_OVERLAP * ma.sum():
             return False, Reason("on_other_object", f"{a} lies over {other}, not on the table")
     high = _not_down(obs, top, a, 0.0, 0.0, "the table", (a,))  # heights are above the table
     if high is not None:
@@ -168,7 +150,7 @@ def _side(obs: Observation, a: str, b: str, left: bool) -> tuple[bool, str]:
     if not len(ca) or not len(cb):
         return False, Reason("not_visible", "both objects must be visible from the top")
     d = float(cb.mean() - ca.mean()) if left else float(ca.mean() - cb.mean())
-    if d < COL_MARGIN:
+    if d < active().COL_MARGIN:
         return False, Reason("wrong_side", f"column difference {d:.0f} px")
     return True, f"column difference {d:.0f} px"
 
@@ -183,7 +165,7 @@ def _near(obs: Observation, a: str, b: str) -> tuple[bool, str]:
     rows = float(np.mean(pa[0]) - np.mean(pb[0]))
     cols = float(np.mean(pa[1]) - np.mean(pb[1]))
     d = float(np.hypot(rows, cols)) * top.pixel_size
-    if d > NEAR:
+    if d > active().NEAR:
         return False, Reason("too_far", f"{d * 100:.0f} cm apart from the top")
     return True, f"{d * 100:.0f} cm apart from the top"
 
@@ -196,12 +178,12 @@ def _lifted(obs: Observation, a: str) -> tuple[bool, str]:
     if rb is None or ra is None:
         return False, Reason("not_visible", f"{a} is not visible from the front")
     rise = rb[1] - ra[1]
-    if rise < LIFT_ROWS:
+    if rise < active().LIFT_ROWS:
         return False, Reason("too_low", f"{a}'s bottom rose by {rise} px in the front view")
     ma = _mask(obs, top, a)
     for i, other in enumerate(obs.labels):
         mo = top.segmentation == i
-        if other != a and mo.sum() > ma.sum() and (ma & hull(mo)).sum() > MIN_OVERLAP * ma.sum():
+        if other != a and mo.sum() > ma.sum() and (ma & hull(mo)).sum() > active().MIN_OVERLAP * ma.sum():
             return False, Reason("on_other_object", f"{a} rests on {other}")
     return True, f"rose by {rise} px"
 
@@ -229,12 +211,12 @@ def _facing(obs: Observation, a: str) -> tuple[bool, str]:
     if len(rows) < 3:
         return False, Reason("not_visible", f"{a}'s upper part does not show from the top")
     spread, axes = np.linalg.eigh(np.cov(np.vstack([rows, cols])))
-    if spread[1] < FACE_ELONGATION ** 2 * max(float(spread[0]), 1e-9):
+    if spread[1] < active().FACE_ELONGATION ** 2 * max(float(spread[0]), 1e-9):
         return False, Reason("cannot_tell",
                              f"{a}'s upper part is not flat enough from the top to tell which way it faces")
     to_robot = np.array(top.robot_base) - [rows.mean(), cols.mean()]
     off = float(np.arccos(min(1.0, abs(float(axes[:, 0] @ to_robot)) / float(np.linalg.norm(to_robot)))))
-    if off > FACE_TOL:
+    if off > active().FACE_TOL:
         return False, Reason("turned_away", f"{a}'s face is turned {np.degrees(off):.0f} degrees from the "
                              "robot (from the top)")
     seen = _mask(obs, front, a)
@@ -244,12 +226,12 @@ def _facing(obs: Observation, a: str) -> tuple[bool, str]:
                              "robot cannot be seen")
     upper = seen.copy()
     upper[front_rows[0] + int(0.6 * (front_rows[1] - front_rows[0])):] = False
-    if upper.sum() < FACE_MIN_PX:
+    if upper.sum() < active().FACE_MIN_PX:
         return False, Reason("not_visible", f"too little of {a} shows from the front to tell which of its "
                              "sides faces the robot")
     p10, p90 = np.percentile(front.rgb[upper].astype(float).mean(axis=1), [10, 90])
     contrast = float(p90 / max(p10, 1.0))
-    if contrast > FACE_CONTRAST:
+    if contrast > active().FACE_CONTRAST:
         return False, Reason("facing_away", f"{a} shows its face to the front camera (contrast "
                              f"x{contrast:.1f}): it faces away from the robot")
     return True, f"faces the robot within {np.degrees(off):.0f} degrees, its plain back to the front camera"
@@ -269,7 +251,7 @@ def _hanging(obs: Observation, a: str, b: str) -> tuple[bool, str]:
     if not ma.any() or not mb.any():
         return False, Reason("not_visible", f"{a} or {b} is not visible from the top")
     high = _highest(heights, ma)
-    if high < reach + HANG_CLEAR:
+    if high < reach + active().HANG_CLEAR:
         return False, Reason("too_low", f"{a}'s top is {100 * high:.1f} cm above the table, no higher than "
                              f"it reaches resting any way up ({100 * reach:.1f} cm): it does not hang")
     if not touch(ma, mb):

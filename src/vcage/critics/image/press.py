@@ -7,17 +7,7 @@ import numpy as np
 
 from vcage.critics.base import Observation, Reason, View
 from vcage.critics.image.measure import _heights, _mask, _peak, _top_band, _touch_depth, _type_of
-from vcage.critics.image.thresholds import (
-    BUTTON_COVER,
-    FINGER_CONTACT,
-    FRONT,
-    HAND_TOP,
-    NEARER,
-    PRESS_ROOM,
-    PRESS_SHARE,
-    ROBOT,
-    TOP,
-)
+from vcage.critics.image.thresholds import FRONT, ROBOT, TOP, active
 from vcage.critics.masks import (
     TOUCH,
     dilate,
@@ -60,7 +50,7 @@ def _pressed(obs: Observation, x: str) -> tuple[bool, str]:
     if hidden and (cover is None or reading is None):
         return False, Reason("cannot_tell", f"an object in front hides where the hand met {x}, and the top "
                              "view cannot measure it")
-    if cover is not None and cover < BUTTON_COVER:
+    if cover is not None and cover < active().BUTTON_COVER:
         return False, Reason("not_covered",
                              f"the hand covered {cover:.0%} of {x}'s top (its button) at its lowest")
     if reading is not None:
@@ -68,7 +58,7 @@ def _pressed(obs: Observation, x: str) -> tuple[bool, str]:
         if depth < share * full:
             return False, Reason("too_shallow", f"the hand stopped {1000 * (share * full - depth):.1f} mm "
                                  f"short of pressing {x} down its travel")
-        if depth > full + PRESS_ROOM:
+        if depth > full + active().PRESS_ROOM:
             return False, Reason("too_deep", f"the hand went {1000 * (depth - full):.1f} mm deeper than a "
                                  f"full press of {x}: {x} gave way under it (tipped, slid or fell)")
     return True, "the hand touched and covered it at its lowest"
@@ -93,11 +83,11 @@ def _contact_hidden(obs: Observation, front: View, x: str) -> bool:
     robot = seg == ROBOT
     below, below_depth = seg[1:], depth[1:]
     occluder = (robot[:-1] & (below >= 0) & (below != obs.labels.index(x))
-                & (below_depth < depth[:-1] - NEARER))
+                & (below_depth < depth[:-1] - active().NEARER))
     span, ring = mask.copy(), dilate(mask, TOUCH)
     for label in np.unique(seg[ring & ~mask & (seg >= 0)]):  # objects beside what shows of x, nearer
         other = seg == label
-        if np.median(depth[other & ring]) < np.median(depth[mask]) - NEARER:
+        if np.median(depth[other & ring]) < np.median(depth[mask]) - active().NEARER:
             span |= other
     cols = np.nonzero(span.any(axis=0))[0]  # the columns x spans (its visible parts may be slivers)
     return bool(occluder[:, max(cols[0] - TOUCH, 0):cols[-1] + TOUCH + 1].any())
@@ -132,7 +122,7 @@ def _press_depth(obs: Observation, x: str) -> tuple[float, float, float] | None:
                  next((p for p in otype.functional_points if p.joint), None))
     hb, hd = _heights(before), _heights(during)
     mask = _mask(obs, before, x)
-    if point is None or point.kind not in PRESS_SHARE or hb is None or hd is None or not mask.any():
+    if point is None or point.kind not in active().PRESS_SHARE or hb is None or hd is None or not mask.any():
         return None
     over = (during.segmentation == ROBOT) & mask
     if not over.any():
@@ -140,5 +130,5 @@ def _press_depth(obs: Observation, x: str) -> tuple[float, float, float] | None:
     top = _peak(hb, mask)  # the button (lever) at rest: the object's highest point
     scale = top / point.pos[2]  # the press point at rest is the highest point
     full = (point.travel if point.kind == "button" else point.stroke) * scale
-    tcp = float(hd[over].max()) - HAND_TOP
-    return top - (tcp - FINGER_CONTACT), full, PRESS_SHARE[point.kind]
+    tcp = float(hd[over].max()) - active().HAND_TOP
+    return top - (tcp - active().FINGER_CONTACT), full, active().PRESS_SHARE[point.kind]

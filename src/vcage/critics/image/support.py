@@ -22,17 +22,7 @@ from vcage.critics.image.measure import (
     _surface,
     _type_of,
 )
-from vcage.critics.image.thresholds import (
-    AREA_RATIO,
-    CENTRE_TOL,
-    FRONT,
-    LEVEL,
-    MIN_OVERLAP,
-    RIM_GAP,
-    RIM_PERCENTILE,
-    ROW_TOL,
-    TOP,
-)
+from vcage.critics.image.thresholds import FRONT, TOP, active
 from vcage.critics.masks import (
     centroid_in,
     hull,
@@ -61,9 +51,9 @@ def _rests_on(obs: Observation, a: str, b: str, inside: bool) -> tuple[bool, str
     small, big = (ma, hull_b) if hull_a.sum() <= hull_b.sum() else (mb, hull_a)
     overlap = float((small & big).sum() / small.sum())
     btype = _type_of(obs, b)
-    if overlap < MIN_OVERLAP and not (btype is not None and btype.any_face):
+    if overlap < active().MIN_OVERLAP and not (btype is not None and btype.any_face):
         return False, Reason("not_over_target", f"only {overlap:.0%} of {a} overlaps {b} from the top")
-    if not centroid_in(ma, mb, CENTRE_TOL):
+    if not centroid_in(ma, mb, active().CENTRE_TOL):
         return False, Reason("not_over_target", f"the centre of {a} is not over {b} from the top")
     # in a container an object may lie any way up; on a surface, turned over it does not rest on its base
     other = _landed_on_other(obs, top, a, b, inside) or (
@@ -74,9 +64,9 @@ def _rests_on(obs: Observation, a: str, b: str, inside: bool) -> tuple[bool, str
     fa, fb = rows_of(_mask(obs, front, a)), rows_of(_mask(obs, front, b) | _mask(obs, front, a))
     if fa is not None and fb is not None:
         a_bottom = fa[1]
-        if a_bottom < fb[0] - ROW_TOL and not inside:
+        if a_bottom < fb[0] - active().ROW_TOL and not inside:
             return False, Reason("floating", f"{a} floats above {b} in the front view")
-        if a_bottom > fb[1] + ROW_TOL:
+        if a_bottom > fb[1] + active().ROW_TOL:
             return False, Reason("below_target", f"{a} is below {b} in the front view")
     return True, f"{overlap:.0%} overlap from the top"
 
@@ -113,9 +103,9 @@ def _landed_on_other(obs: Observation, top: View, a: str, b: str, inside: bool) 
     slope = btype.placements[0].slope if btype is not None and btype.placements and not inside else 0.0
     ma = _mask(obs, top, a)
     was, now = int(_mask(obs, before, a).sum()), int(ma.sum())
-    turned = was > 0 and not AREA_RATIO[0] <= now / was <= AREA_RATIO[1]
+    turned = was > 0 and not active().AREA_RATIO[0] <= now / was <= active().AREA_RATIO[1]
     fit = _plane(top, ma) if inside and not turned else None
-    leaning = fit is not None and fit[2] > LEVEL
+    leaning = fit is not None and fit[2] > active().LEVEL
     on_rim = _on_rim(obs, top, a, b, fit if leaning else None) if inside and not turned else None
     # leaning, ``a`` may rest against what stands in ``b``: its lower end decides (``on_rim``)
     skip = tuple(obs.labels) if leaning else (a, b)
@@ -143,14 +133,14 @@ def _on_rim(obs: Observation, top: View, a: str, b: str,
     own = _own_height(obs, a)
     if own is None or not now.any() or not mb.any():
         return None
-    rim = float(np.percentile(hb[mb], RIM_PERCENTILE))
+    rim = float(np.percentile(hb[mb], active().RIM_PERCENTILE))
     if lean is not None:
         heights, plane, slope = lean
         low_end = float(np.percentile(heights[_lower_end(plane)], 95))
         under = rim - (low_end - own * float(np.hypot(1.0, slope)))
     else:
         under = rim - (_highest(ha, now) - own)
-    if under < RIM_GAP:
+    if under < active().RIM_GAP:
         where = f"{100 * under:.1f} cm under" if under >= 0 else f"{-100 * under:.1f} cm above"
         return Reason("on_rim", f"{a}'s underside is {where} {b}'s rim: it rests on the rim or on something, "
                       f"not down in {b}")
@@ -164,7 +154,7 @@ def _front_support(obs: Observation, front: View, a: str, b: str) -> tuple[bool,
         return False, Reason("not_visible", f"{b} is hidden from the top and {a} or {b} from the front")
     ca, cb = np.nonzero(fa.any(axis=0))[0], np.nonzero(fb.any(axis=0))[0]
     shared = min(ca[-1], cb[-1]) - max(ca[0], cb[0]) + 1
-    if shared < MIN_OVERLAP * min(len(ca), len(cb)):
+    if shared < active().MIN_OVERLAP * min(len(ca), len(cb)):
         return False, Reason("not_over_target", f"{a} is not over {b} in the front view")
     if np.nonzero(fa)[0].mean() >= np.nonzero(fb)[0].mean() or not touch(fa, fb, front.depth):
         return False, Reason("not_resting", f"{a} does not rest on {b} in the front view")
@@ -210,7 +200,7 @@ def _off_centre(obs: Observation, a: str, b: str) -> Reason | None:
     need = margin * btype.scale_range[0]
     part, what = ma, f"{a}'s centre"
     fit = _plane(top, ma)
-    if fit is not None and fit[2] > LEVEL:
+    if fit is not None and fit[2] > active().LEVEL:
         plane = fit[1]
         part = np.zeros_like(ma)
         part[_inner(ma)] = _lower_end(plane)
