@@ -63,6 +63,8 @@ def main() -> None:
     parser.add_argument("--task", default="put the mouse on the pad")
     parser.add_argument("--arms", default="clean,recovery", help="comma-separated arms of the experiment")
     parser.add_argument("--env-arm", default="clean", help="the arm whose dataset's environment evaluates")
+    parser.add_argument("--only", default="seed*", help="the training runs of each arm to use (a glob: "
+                        "seed0, seed[01])")
     parser.add_argument("--every", type=int, default=1, help="steps between two predicted chunks")
     parser.add_argument("--decay", type=float, default=0.01, help="ACT's weight exp(-decay * i)")
     parser.add_argument("--fit", type=int, default=0, help="also roll out on this many training scenes")
@@ -86,7 +88,7 @@ def main() -> None:
     tag = f"ensemble-e{args.every}-d{args.decay:g}"
     scenes = json.loads((args.work / "eval" / f"{task}.json").read_text())["solved"]
     env_config = DatasetReader(args.work / "data" / task / args.env_arm).config
-    runs = sorted(run for arm in arms for run in (args.work / "runs" / task / arm).glob("seed*")
+    runs = sorted(run for arm in arms for run in (args.work / "runs" / task / arm).glob(args.only)
                   if (run / "evaluation.json").is_file())
     if not runs:
         raise SystemExit(f"no evaluated runs of {arms} under {args.work / 'runs' / task}: run the "
