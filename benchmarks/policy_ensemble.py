@@ -141,15 +141,18 @@ def main() -> None:
         figures[f"{name}: ensemble - plain (paired bootstrap 95%)"] = f"{gap:+.1%} [{low:+.1%}, {high:+.1%}]"
     print(f"{time.perf_counter() - t0:.0f} s")
     if args.record:
+        names = [f"{r.parent.name}/{r.name}" for r in runs]
         path = results.record(
             "policy_ensemble", "Downstream policy: temporal ensembling against chunk execution",
             "Do the same checkpoints succeed more often on the same held-out scenes when they act by "
             "temporal ensembling (a chunk every step, ACT's weights) than when they execute 8 steps of each "
             "chunk?",
             figures,
-            f"{args.task!r}: {len(runs)} checkpoints ({', '.join(arms)} arms of {args.work.name}), "
-            f"{len(scenes)} held-out scenes, ensembling every {args.every} steps with decay {args.decay:g}; "
-            "the interval carries checkpoints and scenes, not dataset draws")
+            f"{args.task!r}: {len(runs)} checkpoint(s) ({', '.join(names)} "
+            f"of {args.work}), {len(scenes)} held-out scenes, ensembling every {args.every} steps with decay "
+            f"{args.decay:g}; the interval carries "
+            + ("checkpoints and scenes" if len(runs) > 1 else "scenes only (one checkpoint)")
+            + ", not dataset draws")
         print(f"recorded in {path}")
 
 
