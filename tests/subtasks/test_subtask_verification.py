@@ -46,6 +46,7 @@ def test_a_scene_is_verified_into_the_database_with_the_funnel(stapler, tmp_path
     assert (good.status, good.successes, good.trials, good.success_rate) == ("accepted", 2, 2, 1.0)
     assert good.ci_low == pytest.approx(0.342, abs=1e-3) and good.ci_high == 1.0
     assert good.source == "template" and good.critic == "image" and good.versions["mujoco"]
+    assert good.versions["critic"] == make_critic(CriticConfig("image")).version()  # image@<rules digest>
     assert [t.outcome for t in trials[press.id]] == ["success", "success"]
     assert rows[silent.id].status == "rejected" and rows[silent.id].source == "llm"
     assert {t.failure_class for t in trials[silent.id]} == {"oracle"}

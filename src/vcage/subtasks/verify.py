@@ -51,7 +51,12 @@ class Funnel:
 
 
 def versions(critic: Critic | None) -> dict[str, str]:
-    return {**software(), "schema": str(SCHEMA_VERSION)}
+    """The software that verified a subtask, the database schema and, where a critic judged, the
+    critic's version (its rules' digest: a subtask verified under other rules can be told apart)."""
+    out = {**software(), "schema": str(SCHEMA_VERSION)}
+    if critic is not None:
+        out["critic"] = critic.version()
+    return out
 
 
 def static_check(cand: Candidate, spec: SceneSpec) -> str | None:
