@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import time
 from dataclasses import replace
 from pathlib import Path
 from typing import Any
@@ -99,7 +100,15 @@ def train_cmd(
                    TimeElapsedColumn(), TimeRemainingColumn(), console=console)
     job = bar.add_task(f"training {config.policy}", total=config.steps)
 
+    began = time.perf_counter()
+
     def update(step: int, total: int, loss: float) -> None:
+        if not console.is_terminal:  # a log file gets a line at every checkpoint instead of a bar
+            if step % config.checkpoint_every == 0 or step == total:
+                passes = step * config.batch_size / max(frames, 1)
+                console.print(f"step {step}/{total} ({passes:.1f} passes), loss {loss:.4f}, "
+                              f"{time.perf_counter() - began:.0f} s", highlight=False)
+            return
         if not bar.live.is_started:
             bar.start()
         bar.update(job, completed=step, description=f"training {config.policy} (loss {loss:.4f})")
