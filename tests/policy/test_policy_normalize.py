@@ -61,10 +61,12 @@ def test_a_floor_keeps_a_dimension_that_barely_moves_from_being_stretched() -> N
 def test_rotation_columns_get_their_own_floor() -> None:
     from vcage.policy import TrainConfig
     from vcage.policy.dataset import FeatureSpec
+    from vcage.policy.encoding import VectorEncoder
     from vcage.policy.train import floors
 
     pose = FeatureSpec("observation.ee_pose", 7, ("x", "y", "z", "qw", "qx", "qy", "qz"))
     config = TrainConfig(norm_floor=0.01, rotation_floor=0.05)
-    np.testing.assert_array_equal(floors([pose], config), [0.01] * 3 + [0.05] * 6)
+    encoder = VectorEncoder([pose], config.rotations)
+    np.testing.assert_array_equal(floors(encoder, config), [0.01] * 3 + [0.05] * 6)
     with pytest.raises(ConfigError, match="norm_floor"):
         TrainConfig(norm_floor=-0.1)

@@ -50,36 +50,33 @@ class Feature(Protocol):
     def names(self) -> tuple[str, ...] | None: ...
 
 
-def quaternion_starts(names: Sequence[str] | None) -> list[int]:
-    """Indices at which a run of ``qw, qx, qy, qz`` element names (one common prefix) starts."""
+def named_runs(names: Sequence[str] | None, suffixes: Sequence[str]) -> list[tuple[str, int]]:
+    """(prefix, index) of each run of element names ending in ``suffixes`` in order with one common
+    prefix (``""`` for none, else an object's name and a dot: ``bell.``), runs not overlapping."""
     if not names:
         return []
-    starts, i = [], 0
-    while i + 4 <= len(names):
-        run = zip(names[i:i + 4], QUATERNION, strict=True)
-        prefixes = {n[:-2] if n.endswith(q) else None for n, q in run}
+    found, i, n = [], 0, len(suffixes)
+    while i + n <= len(names):
+        run = zip(names[i:i + n], suffixes, strict=True)
+        prefixes = {name[:-len(suffix)] if name.endswith(suffix) else None for name, suffix in run}
         prefix = prefixes.pop() if len(prefixes) == 1 else None
         if prefix is not None and (prefix == "" or prefix.endswith(".")):
-            starts.append(i)
-            i += 4
+            found.append((prefix, i))
+            i += n
         else:
             i += 1
-    return starts
+    return found
+
+
+def quaternion_starts(names: Sequence[str] | None) -> list[int]:
+    """Indices at which a run of ``qw, qx, qy, qz`` element names (one common prefix) starts."""
+    return [i for _, i in named_runs(names, QUATERNION)]
 
 
 def position_starts(names: Sequence[str] | None) -> list[tuple[str, int]]:
     """(prefix, index) of each run of ``x, y, z`` element names with one common prefix (``""`` for
     none, else ending in a dot: ``mouse.``)."""
-    if not names:
-        return []
-    found = []
-    for i in range(len(names) - 2):
-        run = zip(names[i:i + 3], POSITION, strict=True)
-        prefixes = {n[:-1] if n.endswith(p) else None for n, p in run}
-        prefix = prefixes.pop() if len(prefixes) == 1 else None
-        if prefix is not None and (prefix == "" or prefix.endswith(".")):
-            found.append((prefix, i))
-    return found
+    return named_runs(names, POSITION)
 
 
 def rot6d(quat: np.ndarray) -> np.ndarray:

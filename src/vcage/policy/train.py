@@ -13,7 +13,7 @@ import contextlib
 import math
 import os
 import time
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, fields
 from pathlib import Path
 from typing import Any
@@ -32,7 +32,7 @@ from vcage.policy.checkpoint import (
     save_checkpoint,
 )
 from vcage.policy.config import TrainConfig
-from vcage.policy.dataset import FeatureSpec, TrainingData, load_training_data
+from vcage.policy.dataset import TrainingData, load_training_data
 from vcage.policy.devices import torch_device
 from vcage.policy.ema import Ema
 from vcage.policy.encoding import VectorEncoder
@@ -223,12 +223,11 @@ def _resume_from(out: Path, config: TrainConfig, resume: bool) -> dict[str, Any]
     return payload
 
 
-def floors(features: Sequence[FeatureSpec], config: TrainConfig, observations: bool = True) -> np.ndarray:
-    """The smallest normalisation scale of each value the policy reads (``observations``) or writes:
-    ``rotation_floor`` for rotation-matrix columns, ``norm_floor`` for the rest (see
-    :mod:`vcage.policy.normalize`)."""
-    relative = config.relative_objects and observations
-    mask = VectorEncoder(features, config.rotations, relative).rotation_mask()
+def floors(encoder: VectorEncoder, config: TrainConfig) -> np.ndarray:
+    """The smallest normalisation scale of each value ``encoder`` gives the policy (its observation
+    input or its action): ``rotation_floor`` for rotation-matrix columns, ``norm_floor`` for the rest
+    (see :mod:`vcage.policy.normalize`)."""
+    mask = encoder.rotation_mask()
     return np.where(mask, config.rotation_floor, config.norm_floor)
 
 
@@ -256,9 +255,10 @@ def train(dataset: str | Path, out: str | Path, config: TrainConfig, *, resume: 
         normalization = {k: Normalizer.from_dict(v) for k, v in saved["normalization"].items()}
     else:
         normalization = {
-            "obs": Normalizer.fit(data.obs, config.obs_norm, floors(data.obs_features, config)),
-            "action": Normalizer.fit(data.action, "min_max",
-                                     floors([data.action_feature], config, observations=False))}
+            "obs": Normalizer.fit(data.obs, config.obs_norm, floors(VectorEncoder(
+                data.obs_features, config.rotations, config.relative_objects), config)),
+            "action": Normalizer.fit(data.action, "min_max", floors(VectorEncoder(
+                [data.action_feature], config.rotations), config))}
     with deterministic(threads, where):
         if graph and where.type != "cuda":
             raise ConfigError(f"a CUDA graph of the training step needs a CUDA device, not {device!r}")
