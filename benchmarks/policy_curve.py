@@ -19,22 +19,11 @@ from __future__ import annotations
 
 import argparse
 import functools
-import json
 import re
 import time
 from pathlib import Path
-from typing import Any
 
-from policy_vcage_vs_vanilla import wilson
-
-
-def read_scenes(path: Path) -> list[int]:
-    data = json.loads(path.read_text())
-    seeds = data["solved"] if isinstance(data, dict) else data
-    if not isinstance(seeds, list) or not seeds or not all(isinstance(s, int) and s >= 0 for s in seeds):
-        raise SystemExit(f"{path}: expected a list of scene seeds (or an object with 'solved'), got "
-                         f"{data!r:.80}")
-    return seeds
+from policy_vcage_vs_vanilla import cached_evaluation, wilson
 
 
 def main() -> None:
@@ -49,6 +38,7 @@ def main() -> None:
     parser.add_argument("--workers", type=int, default=1)
     parser.add_argument("--batch", type=int, default=8)
     args = parser.parse_args()
+    from vcage.cli.evaluate import read_scenes
     from vcage.data import DatasetReader
     from vcage.pipeline.evaluation import make_env
     from vcage.policy.checkpoint import checkpoints, load_checkpoint
@@ -70,11 +60,9 @@ def main() -> None:
         chosen = found[::args.every] + ([found[-1]] if (len(found) - 1) % args.every else [])
         for path in chosen:
             cache = path.with_name(f"{path.stem}.eval-{tag}.json")
-            if not cache.is_file():
-                result = evaluate(path, episodes, seed=args.seed, env_config=env_config, threads=1,
-                                  make_env=factory, workers=args.workers, batch=args.batch)
-                cache.write_text(json.dumps(result.to_dict()))
-            record: dict[str, Any] = json.loads(cache.read_text())
+            record = cached_evaluation(cache, functools.partial(
+                evaluate, path, episodes, seed=args.seed, env_config=env_config, threads=1, make_env=factory,
+                workers=args.workers, batch=args.batch))
             payload = load_checkpoint(path)
             step = int(payload["step"])
             passes[step] = step * int(payload["config"]["batch_size"]) / int(payload["dataset"]["frames"])

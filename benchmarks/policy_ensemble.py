@@ -30,7 +30,7 @@ from typing import Any
 import numpy as np
 
 import results
-from policy_vcage_vs_vanilla import slug, wilson
+from policy_vcage_vs_vanilla import cached_evaluation, slug, wilson
 
 
 def paired_gap(a: np.ndarray, b: np.ndarray, draws: int, rng: np.random.Generator
@@ -45,12 +45,6 @@ def paired_gap(a: np.ndarray, b: np.ndarray, draws: int, rng: np.random.Generato
         samples[i] = (a[rows][:, cols] - b[rows][:, cols]).mean()
     low, high = np.percentile(samples, [2.5, 97.5])
     return gap, float(low), float(high)
-
-
-def cached(path: Path, make: Any) -> dict[str, Any]:
-    if not path.is_file():
-        path.write_text(json.dumps(make().to_dict()))
-    return json.loads(path.read_text())
 
 
 def successes(record: dict[str, Any]) -> list[float]:
@@ -75,6 +69,7 @@ def main() -> None:
     parser.add_argument("--record", action="store_true", help="write the figures to "
                         "docs/results/policy_ensemble.json (the results page)")
     args = parser.parse_args()
+    from vcage.cli.evaluate import read_scenes
     from vcage.data import DatasetReader
     from vcage.pipeline.evaluation import make_env
     from vcage.policy.checkpoint import load_checkpoint
@@ -86,7 +81,7 @@ def main() -> None:
     arms = [a.strip() for a in args.arms.split(",") if a.strip()]
     ensemble = TemporalEnsemble(args.every, args.decay)
     tag = f"ensemble-e{args.every}-d{args.decay:g}"
-    scenes = json.loads((args.work / "eval" / f"{task}.json").read_text())["solved"]
+    scenes = read_scenes(args.work / "eval" / f"{task}.json")
     env_config = DatasetReader(args.work / "data" / task / args.env_arm).config
     runs = sorted(run for arm in arms for run in (args.work / "runs" / task / arm).glob(args.only)
                   if (run / "evaluation.json").is_file())
@@ -104,11 +99,10 @@ def main() -> None:
         if len(plain["per_episode"]) != len(scenes):
             raise SystemExit(f"{run}/evaluation.json holds {len(plain['per_episode'])} episodes, the "
                              f"held-out scenes are {len(scenes)}")
-        batch = args.batch
         roll = functools.partial(evaluate, run, len(scenes), seed=int(plain["seed"]), env_config=env_config,
                                  threads=1, make_env=functools.partial(make_env, scenes=scenes),
-                                 workers=args.workers, batch=batch)
-        ens = cached(run / f"evaluation-{tag}.json", functools.partial(roll, ensemble=ensemble))
+                                 workers=args.workers, batch=args.batch)
+        ens = cached_evaluation(run / f"evaluation-{tag}.json", functools.partial(roll, ensemble=ensemble))
         held["plain"].append(successes(plain))
         held["ensemble"].append(successes(ens))
         line = f"{run.parent.name + '/' + run.name:24s} {int(sum(held['plain'][-1])):4d}/{len(scenes):<3d} " \
@@ -117,10 +111,10 @@ def main() -> None:
             mine = training_scenes(load_checkpoint(run), args.fit)
             fitted = functools.partial(evaluate, run, len(mine), seed=0, env_config=env_config, threads=1,
                                        make_env=functools.partial(make_env, scenes=mine),
-                                       workers=args.workers, batch=batch)
+                                       workers=args.workers, batch=args.batch)
             for way, extra in (("plain", {}), ("ensemble", {"ensemble": ensemble})):
                 name = f"fit{len(mine)}-plain.json" if way == "plain" else f"fit{len(mine)}-{tag}.json"
-                fit[way].append(successes(cached(run / name, functools.partial(fitted, **extra))))
+                fit[way].append(successes(cached_evaluation(run / name, functools.partial(fitted, **extra))))
             line += (f" {int(sum(fit['plain'][-1])):6d}/{len(mine):<3d}"
                      f" {int(sum(fit['ensemble'][-1])):5d}/{len(mine):<3d}")
         print(line, flush=True)

@@ -36,7 +36,15 @@ from typing import Any
 import numpy as np
 
 import results
-from policy_vcage_vs_vanilla import DEFAULT_OBS, slug, solvable_scenes, train_all, trained_record, wilson
+from policy_vcage_vs_vanilla import (
+    DEFAULT_OBS,
+    cached_evaluation,
+    slug,
+    solvable_scenes,
+    train_all,
+    trained_record,
+    wilson,
+)
 
 ARMS = ("clean", "recovery")
 
@@ -130,13 +138,10 @@ def main() -> None:
         rows = []
         for s in range(args.train_seeds):
             run = run_dir(args.work, args.task, arm, s)
-            path = run / "evaluation.json"
-            if not path.is_file():
-                ev = evaluate(run, len(scenes), seed=0, env_config=env_config, threads=1,
-                              make_env=functools.partial(make_env, scenes=scenes), workers=args.workers,
-                              batch=args.eval_batch)
-                path.write_text(json.dumps(ev.to_dict()))
-            rows.append(json.loads(path.read_text()))
+            rows.append(cached_evaluation(run / "evaluation.json", functools.partial(
+                evaluate, run, len(scenes), seed=0, env_config=env_config, threads=1,
+                make_env=functools.partial(make_env, scenes=scenes), workers=args.workers,
+                batch=args.eval_batch)))
         outcomes[arm] = np.array([[e["success"] for e in r["per_episode"]] for r in rows], dtype=float)
         s, n = int(outcomes[arm].sum()), outcomes[arm].size
         low, high = wilson(s, n)

@@ -57,6 +57,7 @@ import json
 import os
 import re
 import time
+from collections.abc import Callable
 from dataclasses import replace
 from pathlib import Path
 from typing import Any
@@ -267,6 +268,14 @@ def train_and_evaluate(task: str, method: str, dataset: Path, env_config: dict[s
     path.parent.mkdir(parents=True, exist_ok=True)
     path.write_text(json.dumps(out, indent=1))
     return out
+
+
+def cached_evaluation(path: Path, make: Callable[[], Any]) -> dict[str, Any]:
+    """The evaluation stored at ``path`` (JSON), made by ``make()`` (an ``Evaluation``) and stored
+    first if it is not there: an interrupted experiment resumes without rolling out again."""
+    if not path.is_file():
+        path.write_text(json.dumps(make().to_dict()))
+    return dict(json.loads(path.read_text()))
 
 
 def wilson(successes: int, n: int) -> tuple[float, float]:
