@@ -13,6 +13,7 @@ last line. Given-up episodes exist only here.
 from __future__ import annotations
 
 import json
+import re
 from collections.abc import Iterable
 from pathlib import Path
 from typing import Any
@@ -24,6 +25,17 @@ from vcage.errors import CorruptDatasetError
 from vcage.pipeline.stage import Stage
 
 Record = dict[str, Any]
+
+
+def rejection_group(record: Record) -> str:
+    """What a rejected attempt counts under in a funnel: the first of its critic's reason codes (the
+    cause of its first failed check, e.g. ``pressed.too_shallow``); without codes (a skill or scene
+    failure, a critic that gives none, a log written before codes were), its reason's first clause
+    with numbers replaced by ``N``."""
+    codes = record.get("codes")
+    if codes:
+        return str(codes[0])
+    return re.sub(r"\d+(\.\d+)?", "N", str(record.get("reason", "")).split(";")[0]).strip()[:90]
 
 
 def read(path: Path, torn_tail: bool = True) -> list[Record]:

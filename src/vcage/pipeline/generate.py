@@ -13,7 +13,6 @@ episode it holds), after reconciling the attempt log with what a crash may have 
 
 from __future__ import annotations
 
-import re
 import time
 from collections import Counter
 from collections.abc import Callable
@@ -204,18 +203,4 @@ def _count(funnel: Funnel, record: dict[str, Any], timing: Timing) -> None:
         if not record["oracle_success"]:
             funnel.accepted_oracle_failed += 1
     else:
-        funnel.reasons[(record["stage"], _rejection_key(record))] += 1
-
-
-def _rejection_key(record: dict[str, Any]) -> str:
-    """What a rejected attempt's record counts under: the first of its critic's reason codes (the cause
-    of its first failed check, e.g. ``pressed.too_shallow``); without codes (a skill or scene failure,
-    a critic that gives none, a log written before codes were), its reason's first clause."""
-    codes = record.get("codes")
-    return str(codes[0]) if codes else _reason_key(record["reason"])
-
-
-def _reason_key(reason: str) -> str:
-    return re.sub(r"\d+(\.\d+)?", "N", reason.split(";")[0]).strip()[:90]
-
-
+        funnel.reasons[(record["stage"], attempt_log.rejection_group(record))] += 1

@@ -9,12 +9,12 @@ replaced by ``N`` (a skill's failure, a critic without codes, a log written befo
 
 from __future__ import annotations
 
-import re
 from collections import Counter
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
+from vcage.pipeline.attempt_log import rejection_group
 from vcage.pipeline.stage import Stage
 
 STAGES = tuple(Stage)  # the order stages are shown in: where an attempt can end, then accepted
@@ -46,10 +46,6 @@ class FunnelCounts:
         return self.accepted / self.attempts if self.attempts else 0.0
 
 
-def reason_group(reason: str) -> str:
-    return re.sub(r"\d+(\.\d+)?", "N", reason.split(";")[0]).strip()[:90]
-
-
 def count(records: Sequence[dict[str, Any]]) -> FunnelCounts:
     """The funnel of attempt-log ``records`` (see :mod:`vcage.pipeline.attempt_log`)."""
     stages: Counter[str] = Counter()
@@ -63,8 +59,7 @@ def count(records: Sequence[dict[str, Any]]) -> FunnelCounts:
         if stage == Stage.ACCEPTED:
             accepted_samples.add(int(rec["episode"]))
         else:
-            codes = rec.get("codes")
-            reasons[(stage, str(codes[0]) if codes else reason_group(str(rec.get("reason", ""))))] += 1
+            reasons[(stage, rejection_group(rec))] += 1
     known = {str(s): stages.get(str(s), 0) for s in STAGES}
     known.update({s: n for s, n in stages.items() if s not in known})  # a stage of a newer version
     return FunnelCounts(
