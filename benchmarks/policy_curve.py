@@ -5,7 +5,8 @@ longer), or did it level off or fall earlier (the budget is not what holds it ba
 its checkpoints unless ``--keep-checkpoints`` was given (``vcage train`` keeps all by default; the
 experiment scripts keep two). Each checkpoint is evaluated like ``vcage evaluate CHECKPOINT``, on
 the run's dataset environment (or ``--env``), on ``--scenes`` (a JSON list of scene seeds, or an
-experiment's ``eval/TASK.json``) or the environment's own held-out scenes, with the same evaluation
+experiment's ``eval/TASK.json``), ``--training-scenes`` (the scenes of the run's own training episodes:
+the fit) or the environment's own held-out scenes, with the same evaluation
 seed and batch for every checkpoint, so that the rows differ only in the weights. It prints, per
 checkpoint, the step, the passes over the data, the successes and their Wilson interval; a
 checkpoint's evaluation is cached beside it (``step-N.eval-<tag>.json``). With several runs (e.g.
@@ -30,6 +31,8 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("runs", type=Path, nargs="+", help="training run directories (vcage train --out)")
     parser.add_argument("--scenes", type=Path, help="scene seeds to roll out on (default: held-out scenes)")
+    parser.add_argument("--training-scenes", action="store_true",
+                        help="roll out on each run's own training scenes (the fit) instead")
     parser.add_argument("--episodes", type=int, default=50)
     parser.add_argument("--seed", type=int, default=0, help="evaluation seed")
     parser.add_argument("--env", type=Path, help="evaluate in this dataset's environment")
@@ -42,15 +45,14 @@ def main() -> None:
     from vcage.data import DatasetReader
     from vcage.pipeline.evaluation import make_env
     from vcage.policy.checkpoint import checkpoints, load_checkpoint
-    from vcage.policy.evaluate import evaluate
+    from vcage.policy.evaluate import evaluate, training_scenes
 
+    if args.training_scenes and args.scenes:
+        raise SystemExit("--training-scenes and --scenes choose the scenes two ways: give one")
     t0 = time.perf_counter()
-    scenes = read_scenes(args.scenes) if args.scenes else None
-    episodes = min(args.episodes, len(scenes)) if scenes else args.episodes
+    given = read_scenes(args.scenes) if args.scenes else None
     env_config = DatasetReader(args.env).config if args.env else None
-    factory = functools.partial(make_env, scenes=scenes) if scenes else None
-    tag = re.sub(r"[^A-Za-z0-9]+", "-", f"{args.scenes.stem if args.scenes else 'held-out'}-n{episodes}"
-                 f"-s{args.seed}-b{args.batch}")
+    name = args.scenes.stem if args.scenes else "training" if args.training_scenes else "held-out"
     table: dict[int, dict[int, tuple[int, int]]] = {}  # step -> run index -> (successes, episodes)
     passes: dict[int, float] = {}
     for index, run in enumerate(args.runs):
@@ -58,6 +60,10 @@ def main() -> None:
         if not found:
             raise SystemExit(f"{run} holds no checkpoint: pass a vcage train --out directory")
         chosen = found[::args.every] + ([found[-1]] if (len(found) - 1) % args.every else [])
+        scenes = training_scenes(load_checkpoint(found[0]), args.episodes) if args.training_scenes else given
+        episodes = min(args.episodes, len(scenes)) if scenes else args.episodes
+        factory = functools.partial(make_env, scenes=scenes) if scenes else None
+        tag = re.sub(r"[^A-Za-z0-9]+", "-", f"{name}-n{episodes}-s{args.seed}-b{args.batch}")
         for path in chosen:
             cache = path.with_name(f"{path.stem}.eval-{tag}.json")
             record = cached_evaluation(cache, functools.partial(
