@@ -57,7 +57,6 @@ from vcage.pipeline.config import GenerateConfig  # noqa: E402
 from vcage.pipeline.episode import Timing  # noqa: E402
 from vcage.pipeline.plan_layout import plan_layout  # noqa: E402
 from vcage.pipeline.rollout import run_plan  # noqa: E402
-from vcage.pipeline.verifier import Verifier  # noqa: E402
 from vcage.planning import make_planner  # noqa: E402
 from vcage.planning.goals import GOALS  # noqa: E402
 from vcage.planning.schema import Plan  # noqa: E402
@@ -67,6 +66,7 @@ from vcage.skills.base import Skills  # noqa: E402
 from vcage.skills.faults import FaultConfig, FaultInjector, faults_for  # noqa: E402
 from vcage.skills.playback import Player  # noqa: E402
 from vcage.skills.reachability import reach_map  # noqa: E402
+from vcage.tasks.verifier import Verifier  # noqa: E402
 from vlm_tape import Tape, tape_model  # noqa: E402
 
 DEFAULT_GOALS = ("get_ready_for_work", "prepare_breakfast", "tidy_the_desk", "set_the_table",
@@ -115,7 +115,7 @@ def rollout(goal: str, index: int, seed: int, fault: str | None) -> Sample | str
     skills = Skills(world, Player(world, record_states=True), fault=injector)
     keep = Recorder()
     with Renderer(world, *cfg.render.critic_size, cfg.render.mesh_detail) as renderer:
-        verifier = Verifier(world, plan, keep, renderer, skills.player.recording, Timing())
+        verifier = Verifier(world, plan.subtasks, keep, renderer, skills.player.recording, Timing())
         result = run_plan(world, plan, skills, verifier)
     outcomes = result.outcomes
     if len(outcomes) <= index or outcomes[index].skill_error is not None:

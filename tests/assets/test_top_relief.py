@@ -12,7 +12,7 @@ from vcage.scene.compose import compose
 from vcage.scene.spec import ObjectSpec as O
 from vcage.scene.spec import SceneSpec
 from vcage.sim.render import Renderer
-from vcage.subtasks.judge import render_views
+from vcage.tasks.verifier import render_views
 
 
 @pytest.mark.parametrize("name", CATALOG.names_where(lambda t: t.top_relief > 0))

@@ -10,13 +10,13 @@ import pytest
 from vcage.assets.catalog import CATALOG
 from vcage.critics.image.measure import _heights
 from vcage.critics.image.thresholds import DEFAULT
-from vcage.pipeline.verifier import render_views
 from vcage.scene.compose import compose
 from vcage.scene.spec import ObjectSpec, SceneSpec
 from vcage.sim.render import ROBOT, Renderer
 from vcage.skills.base import Skills
 from vcage.skills.faults import FaultConfig, FaultInjector
 from vcage.skills.playback import Player
+from vcage.tasks.verifier import render_views
 
 FINGER_CONTACT, HAND_TOP, PRESS_SHARE = DEFAULT.FINGER_CONTACT, DEFAULT.HAND_TOP, DEFAULT.PRESS_SHARE
 

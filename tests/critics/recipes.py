@@ -37,7 +37,6 @@ from vcage.critics.observation_file import load_observation, save_observation
 from vcage.pipeline.config import GenerateConfig
 from vcage.pipeline.episode import Timing, attempt
 from vcage.pipeline.rollout import run_plan
-from vcage.pipeline.verifier import Verifier
 from vcage.planning import make_planner
 from vcage.planning.goals import GOALS, close_drawer, hang, open_drawer, press, put_in, put_on, turn_to_face
 from vcage.planning.schema import Plan, PlanObject, Predicate, Subtask
@@ -49,8 +48,8 @@ from vcage.sim.world import World
 from vcage.skills.base import Skills
 from vcage.skills.faults import FaultConfig, FaultInjector
 from vcage.skills.playback import Player
-from vcage.subtasks.judge import render_views
 from vcage.tasks import predicates as P
+from vcage.tasks.verifier import Verifier, render_views
 
 HERE = Path(__file__).parent / "observations"
 
@@ -198,7 +197,7 @@ def _run(objects: tuple[O, ...], subtask: Subtask, fault: str | None = None, see
     skills = Skills(world, Player(world, record_states=True), fault=injector)
     keep = Recorder()
     with Renderer(world, 320, 240) as renderer:
-        verifier = Verifier(world, plan, keep, renderer, skills.player.recording, Timing())
+        verifier = Verifier(world, plan.subtasks, keep, renderer, skills.player.recording, Timing())
         rollout = run_plan(world, plan, skills, verifier)
     outcome = rollout.outcomes[-1]
     assert len(rollout.outcomes) == len(plan.subtasks) and outcome.skill_error is None, outcome.skill_error

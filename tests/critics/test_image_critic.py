@@ -12,7 +12,6 @@ from vcage.critics.base import Observation, View
 from vcage.critics.image import ImageCritic
 from vcage.critics.image.thresholds import DEFAULT
 from vcage.critics.masks import best_move, inward, moved
-from vcage.pipeline.verifier import render_views
 from vcage.planning.goals import put_at, put_on
 from vcage.planning.schema import Predicate, Subtask
 from vcage.scene.compose import compose
@@ -20,6 +19,7 @@ from vcage.scene.spec import ObjectSpec, SceneSpec
 from vcage.sim.render import Renderer
 from vcage.sim.world import World
 from vcage.tasks.oracle import Oracle
+from vcage.tasks.verifier import render_views
 
 CRITIC = ImageCritic()
 PAD = ObjectSpec("pad", "mouse_pad", (0.58, 0.1))

@@ -100,6 +100,8 @@ def test_replaying_the_expert_recording_succeeds() -> None:
         assert reward == 1.0 and info["success"] and info["is_success"]
         hold = env.get_wrapper_attr("hold_steps")
         assert rewards[-hold:] == [1.0] * hold
+        with pytest.raises(gym.error.ResetNeeded):  # a terminated episode is over
+            env.step(actions[-1].astype(np.float32))
     finally:
         env.close()
 

@@ -12,7 +12,7 @@ from vcage.sim.world import World
 from vcage.skills.base import Skills
 from vcage.skills.playback import Player
 from vcage.tasks import TASKS, AtomicTask, make_task, place_scene, run_episode
-from vcage.tasks.success import held
+from vcage.tasks.engine import held
 
 ALL_TASKS = TASKS.names()
 

@@ -20,7 +20,6 @@ from vcage.pipeline.features import objects_of
 from vcage.pipeline.plan_layout import episode_scene, plan_layout
 from vcage.pipeline.rollout import Rollout, run_plan
 from vcage.pipeline.stage import Stage
-from vcage.pipeline.verifier import Verifier
 from vcage.planning.schema import Plan
 from vcage.scene.compose import compose
 from vcage.scene.instantiate import Instantiator, SceneInstance
@@ -32,6 +31,7 @@ from vcage.skills.base import Skills
 from vcage.skills.playback import Player, Recording
 from vcage.skills.reachability import reach_map
 from vcage.skills.recovery import Perturbation, move_start
+from vcage.tasks.verifier import Verifier
 
 # Where a run's time goes, phase by phase, in the order an episode meets them. An attempt fills
 # placement .. critic_judge; the driver adds planning (once per run) and what an accepted episode
@@ -177,7 +177,7 @@ def _execute(plan: Plan, seed: int, cfg: GenerateConfig, critic: Critic | None, 
         timing.critic_views += time.perf_counter() - t0
         verifier = None
         try:
-            verifier = (Verifier(world, plan, critic, renderer, skills.player.recording, timing)
+            verifier = (Verifier(world, plan.subtasks, critic, renderer, skills.player.recording, timing)
                         if critic is not None else None)
             rollout = run_plan(world, plan, skills, verifier)
         finally:

@@ -65,8 +65,8 @@ from vcage.sim.world import World
 from vcage.skills.ik import IKSolver
 from vcage.skills.reachability import reach_map
 from vcage.synthesis.errors import SynthesisError
+from vcage.tasks.engine import PredicateGoal, Progress
 from vcage.tasks.oracle import Oracle
-from vcage.tasks.success import HOLD_STEPS
 from vcage.vocabulary import PREDICATES, Kind
 
 EVAL_SEED_BASE = 2**32  # generation's attempt seeds are below: evaluation scenes are never training scenes
@@ -151,7 +151,8 @@ class GoalEnv(gym.Env[dict[str, np.ndarray], np.ndarray]):
         self.world: World | None = None
         self.scene_seed: int | None = None
         self._oracle = Oracle()
-        self._done = self._streak = self._steps = 0
+        self._progress: Progress | None = None  # the subtasks reached, judged as generation judges them
+        self._steps = 0
         self._renderer: Renderer | None = None
 
     # -- episodes --------------------------------------------------------------------------------
@@ -227,9 +228,10 @@ class GoalEnv(gym.Env[dict[str, np.ndarray], np.ndarray]):
             world.set_state(state)
         self._close_renderer()
         self.world, self.scene_seed = world, scene_seed
-        self._done, self._streak, self._steps = subtask, 0, 0
+        self._steps = 0
         self._arm_target = world.robot.arm_q(world.data)
-        self._oracle.begin(self.plan.subtasks[subtask].predicates)
+        self._progress = Progress([PredicateGoal(self._oracle, world, tuple(sub.predicates))
+                                   for sub in self.plan.subtasks], start=subtask)
         return observe(world, self.plan), self._info()
 
     def _start_subtask(self, options: dict[str, Any]) -> int:
@@ -244,8 +246,8 @@ class GoalEnv(gym.Env[dict[str, np.ndarray], np.ndarray]):
         return int(subtask)
 
     def step(self, action: np.ndarray) -> tuple[dict[str, np.ndarray], float, bool, bool, dict[str, Any]]:
-        world = self.world
-        if world is None or self._done == len(self.plan.subtasks) or self._steps >= self.max_steps:
+        world, progress = self.world, self._progress
+        if world is None or progress is None or progress.finished or self._steps >= self.max_steps:
             raise ResetNeeded("call reset() before step(), and again after an episode ends")
         action = np.asarray(action, dtype=float).reshape(-1)
         if action.shape != (8,) or not np.isfinite(action).all():
@@ -256,22 +258,10 @@ class GoalEnv(gym.Env[dict[str, np.ndarray], np.ndarray]):
             raise ValueError(f"the action's quaternion (elements 3-6) is zero, got {action!r}")
         world.step(world.robot.ctrl(self._joint_targets(action), float(action[7])))
         self._steps += 1
-        self._oracle.on_step(world)
-        reward = 0.0
-        subtask = self.plan.subtasks[self._done]
-        if all(self._oracle.value(world, p) for p in subtask.predicates):
-            self._streak += 1
-        else:
-            self._streak = 0
-        if self._streak >= HOLD_STEPS:
-            self._done, self._streak = self._done + 1, 0
-            if self._done < len(self.plan.subtasks):
-                self._oracle.begin(self.plan.subtasks[self._done].predicates)
-            else:
-                reward = 1.0
-        terminated = self._done == len(self.plan.subtasks)
+        progress.update(world)
+        terminated = progress.finished
         truncated = not terminated and self._steps >= self.max_steps
-        return observe(world, self.plan), reward, terminated, truncated, self._info()
+        return observe(world, self.plan), float(terminated), terminated, truncated, self._info()
 
     def _joint_targets(self, action: np.ndarray) -> np.ndarray:
         """The arm's joint targets of an action: as given, or from the tool pose by IK."""
@@ -292,9 +282,9 @@ class GoalEnv(gym.Env[dict[str, np.ndarray], np.ndarray]):
                    if PREDICATES.get(p.name).kind is not Kind.EVENT)
 
     def _info(self) -> dict[str, Any]:
-        n = len(self.plan.subtasks)
-        return {"success": self._done == n, "subtasks_done": self._done, "subtasks": n,
-                "progress": self._done / n, "scene_seed": self.scene_seed}
+        n, done = len(self.plan.subtasks), self._progress.done if self._progress is not None else 0
+        return {"success": done == n, "subtasks_done": done, "subtasks": n,
+                "progress": done / n, "scene_seed": self.scene_seed}
 
     # -- rendering -------------------------------------------------------------------------------
     def render(self) -> np.ndarray | None:  # type: ignore[override]

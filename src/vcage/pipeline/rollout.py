@@ -1,89 +1,44 @@
-"""Execute a plan's subtasks in order on a world, auditing each one with the oracle.
+"""A plan as a program for the episode engine: a step per subtask, judged by the oracle.
 
-After every subtask the command is held for a moment (success must hold on consecutive control
-steps, :func:`vcage.tasks.success.held`), the oracle's verdict is recorded with the subtask's frame
-boundaries, and an optional verifier (the critic) decides whether to go on. A skill that cannot
-plan ends the rollout.
+Each subtask's step calls its skill and then retreats (so the views after it show the scene
+unobstructed); the oracle, shared by the steps so that events latch while their subtask is the
+current one, judges its predicates on consecutive control steps (:func:`vcage.tasks.engine.run`
+holds); an optional verifier (the critic) decides whether to go on. A skill that cannot plan ends
+the rollout.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
-from functools import partial
-from typing import Any, Protocol
+from typing import Any
 
-from vcage.errors import SkillError
 from vcage.planning.schema import Plan, Subtask
 from vcage.sim.world import World
 from vcage.skills.base import Skills
+from vcage.tasks.engine import PredicateGoal, Rollout, Step, StepVerifier, run
 from vcage.tasks.oracle import Oracle
-from vcage.tasks.success import held
+
+__all__ = ["Rollout", "plan_steps", "run_plan"]
 
 
-@dataclass
-class SubtaskOutcome:
-    index: int
-    skill: str
-    description: str
-    start: int  # first frame of the subtask in the recording
-    end: int  # one past its last frame
-    oracle: dict[str, bool]
-    oracle_success: bool
-    skill_error: str | None = None
-    verdict: dict[str, Any] | None = None  # the critic's, when one judged
-
-
-@dataclass
-class Rollout:
-    outcomes: list[SubtaskOutcome] = field(default_factory=list)
-    aborted_at: int | None = None  # index of the subtask after which the verifier stopped it
-
-    @property
-    def oracle_success(self) -> bool:
-        return bool(self.outcomes) and all(o.oracle_success for o in self.outcomes)
-
-
-class SubtaskVerifier(Protocol):
-    def start(self, index: int, subtask: Subtask) -> None: ...
-
-    def judge(self, outcome: SubtaskOutcome) -> dict[str, Any]:
-        """A verdict with a boolean ``"accept"``."""
+def plan_steps(world: World, plan: Plan, oracle: Oracle | None = None) -> list[Step]:
+    """The engine's steps of ``plan`` on ``world``: each subtask's skill call, then a retreat."""
+    oracle = oracle or Oracle()
+    return [Step(sub.skill, sub.description, _acts(sub), PredicateGoal(oracle, world, tuple(sub.predicates)))
+            for sub in plan.subtasks]
 
 
 def run_plan(world: World, plan: Plan, skills: Skills | None = None,
-             verifier: SubtaskVerifier | None = None) -> Rollout:
-    skills = skills or Skills(world)
-    oracle = Oracle()
-    skills.player.hooks.append(oracle.on_step)
-    rollout = Rollout()
-    for i, sub in enumerate(plan.subtasks):
-        if verifier is not None:
-            verifier.start(i, sub)
-        oracle.begin(sub.predicates)
-        start = len(skills.player.recording)
-        error = None
-        try:
-            skills.do(sub.skill, **_skill_args(sub))
-            skills.do("retreat")  # back home: the views after the subtask show it unobstructed
-        except SkillError as exc:
-            error = str(exc)
-        values, _ = held(skills, partial(oracle.check, world, sub.predicates))
-        outcome = SubtaskOutcome(i, sub.skill, sub.description, start, len(skills.player.recording),
-                                 values, error is None and all(values.values()), error)
-        rollout.outcomes.append(outcome)
-        if error is not None:
-            rollout.aborted_at = i
-            break
-        if verifier is not None:
-            outcome.verdict = verifier.judge(outcome)
-            if not outcome.verdict.get("accept", False):
-                rollout.aborted_at = i
-                break
-    return rollout
+             verifier: StepVerifier | None = None) -> Rollout:
+    """Execute ``plan``'s subtasks in order on ``world`` (see the module's help)."""
+    return run(skills or Skills(world), plan_steps(world, plan), verifier)
 
 
-def _skill_args(sub: Subtask) -> dict[str, Any]:
+def _acts(sub: Subtask) -> Any:
     args = dict(sub.args)
     if isinstance(args.get("xy"), list):
         args["xy"] = tuple(args["xy"])
-    return args
+
+    def act(skills: Skills) -> None:
+        skills.do(sub.skill, **args)
+        skills.do("retreat")  # back home: the views after the subtask show it unobstructed
+    return act

@@ -9,7 +9,7 @@ every call, executes them through :class:`~vcage.skills.Skills`, retreats, holds
 A trial succeeds only if the goal did not already hold before the robot acted (a synthesized scene
 is a goal arrangement: its bread may start in its basket), nothing raised, every skill planned, the
 oracle's predicates held for
-``HOLD_STEPS`` consecutive control steps after settling (``tasks.success.held``), and the critic
+``HOLD_STEPS`` consecutive control steps after settling (``tasks.engine.held``), and the critic
 (when one is configured) accepted. Otherwise it records the first failure class: ``scene``, a
 sandbox status (``rejected``, ``runtime_error``, ``blocked``, ``timeout``, ...), ``invalid_call``,
 ``already_holds``, ``skill``, ``physics``, ``error`` (another typed error), ``oracle`` or ``critic``.
@@ -22,14 +22,13 @@ import json
 import math
 import time
 from dataclasses import dataclass, field
-from functools import partial
 
 import mujoco
 import numpy as np
 
 from vcage.config import SimConfig
 from vcage.critics.base import Critic
-from vcage.errors import SimulationError, SkillError, SubtaskError, VcageError
+from vcage.errors import SimulationError, SubtaskError, VcageError
 from vcage.geometry import yaw_of
 from vcage.sandbox import Call, Limits, SceneSnapshot, run_program
 from vcage.scene.compose import compose
@@ -39,12 +38,12 @@ from vcage.sim.render import Renderer
 from vcage.sim.world import World
 from vcage.skills.base import Skills
 from vcage.skills.playback import Player
-from vcage.subtasks import judge
 from vcage.subtasks.calls import SkillCall, api, check_call
 from vcage.subtasks.candidates import Candidate
 from vcage.subtasks.records import FAILURE, SUCCESS, TrialRecord
+from vcage.tasks.engine import PredicateGoal, Step, run
 from vcage.tasks.oracle import Oracle
-from vcage.tasks.success import held
+from vcage.tasks.verifier import Verifier
 
 
 @dataclass(frozen=True)
@@ -183,27 +182,24 @@ def _execute(cand: Candidate, calls: list[SkillCall], world: World, critic: Crit
              renderer: Renderer | None) -> tuple[str | None, str]:
     skills = Skills(world, Player(world, record_states=renderer is not None))
     oracle = Oracle()
-    skills.player.hooks.append(oracle.on_step)
-    before = judge.views(renderer)
     if all(oracle.check(world, cand.predicates).values()):  # events are never true before begin()
         return "already_holds", "the goal held before the robot acted: nothing to verify in this scene"
-    oracle.begin(cand.predicates)
-    try:
+    subtask = cand.subtask()
+
+    def act(skills: Skills) -> None:
         for call in calls:
             skills.do(call.skill, **call.kwargs)
         if calls[-1].skill != "retreat":
             skills.do("retreat")  # back home: the views after show the scene unobstructed
-    except SkillError as exc:
-        return "skill", str(exc)
-    end = len(skills.player.recording)
-    holds, _ = held(skills, partial(oracle.check, world, cand.predicates))
-    if not all(holds.values()):
-        return "oracle", "predicates do not hold: " + ", ".join(k for k, v in holds.items() if not v)
-    if critic is None:
+
+    verifier = (Verifier(world, [subtask], critic, renderer, skills.player.recording)
+                if critic is not None else None)
+    step = Step(subtask.skill, subtask.description, act, PredicateGoal(oracle, world, tuple(cand.predicates)))
+    outcome = run(skills, [step], verifier, judge_unmet=False).outcomes[0]
+    if outcome.skill_error is not None:
+        return "skill", outcome.skill_error
+    if not outcome.oracle_success:
+        return "oracle", "predicates do not hold: " + ", ".join(k for k, v in outcome.oracle.items() if not v)
+    if outcome.verdict is None:
         return None, "oracle predicates held"
-    subtask = cand.subtask()
-    during = judge.deepest(world, renderer, skills.player.recording, 0, end, subtask.skill)
-    verdict = judge.judge(critic, subtask, world, before, during, judge.views(renderer), holds)
-    if not verdict.accept:
-        return "critic", verdict.reason
-    return None, verdict.reason
+    return (None if outcome.verdict["accept"] else "critic"), str(outcome.verdict["reason"])

@@ -19,8 +19,9 @@ positions in the world frame in metres):
 * ``images`` (only when ``cameras`` are given): camera name -> uint8 RGB (H, W, 3).
 
 Reward is 1.0 on every step whose ``task.evaluate`` reports success, else 0.0. An episode
-terminates once success has held for ``task.hold_steps`` consecutive steps (as the expert's episode
-is judged) and is truncated after ``max_steps`` steps.
+terminates once success has held for ``task.hold_steps`` consecutive steps (the episode engine's
+:class:`~vcage.tasks.engine.Progress`, with the goal the expert's episode is judged by) and is
+truncated after ``max_steps`` steps; a terminated episode must be reset before it is stepped again.
 
 A :class:`~vcage.errors.SimulationError` (unstable physics) raised while stepping is **not**
 swallowed: it propagates out of :meth:`TaskEnv.step`, since an exploded simulation has no meaningful
@@ -45,6 +46,7 @@ from vcage.sim.robot import GRIPPER_OPEN
 from vcage.sim.world import World
 from vcage.tasks import runner
 from vcage.tasks.base import AtomicTask
+from vcage.tasks.engine import Progress, TaskGoal
 
 __all__ = ["RENDER_CAMERA", "TaskEnv"]
 
@@ -129,7 +131,7 @@ class TaskEnv(gym.Env[dict[str, Any], np.ndarray]):
         self.object_names: tuple[str, ...] = ()  # row order of ``object_poses`` this episode
         self._renderer: Renderer | None = None
         self._elapsed = 0
-        self._streak = 0
+        self._progress: Progress | None = None
         self._needs_reset = True
 
     # -- gymnasium API -----------------------------------------------------------------------
@@ -153,7 +155,7 @@ class TaskEnv(gym.Env[dict[str, Any], np.ndarray]):
         if self.cameras or self.render_mode == "rgb_array":
             self._renderer = Renderer(world, width=self.image_size[1], height=self.image_size[0])
         self._elapsed = 0
-        self._streak = 0
+        self._progress = Progress([TaskGoal(task, world)])
         self._needs_reset = False
         info = {"instruction": self.instruction, "seed": episode_seed,
                 "object_names": self.object_names}
@@ -164,11 +166,14 @@ class TaskEnv(gym.Env[dict[str, Any], np.ndarray]):
 
         Raises:
             SimulationError: the physics became unstable; reset before stepping again.
-            ResetNeeded: :meth:`reset` was not called, or a previous step raised.
+            ResetNeeded: :meth:`reset` was not called, the episode terminated, or a previous step
+                raised.
             ValueError: the action has the wrong size or is not finite.
         """
-        if self._needs_reset or self.world is None or self.task is None:
-            raise ResetNeeded("call reset() before step() (and after a SimulationError)")
+        progress = self._progress
+        if self._needs_reset or self.world is None or progress is None or progress.finished:
+            raise ResetNeeded("call reset() before step() (and after the episode terminated or a "
+                              "SimulationError)")
         act = np.asarray(action, dtype=np.float64).reshape(-1)
         if act.shape != self._act_low.shape:
             raise ValueError("action must have 8 values (7 arm joint targets + gripper), "
@@ -176,16 +181,14 @@ class TaskEnv(gym.Env[dict[str, Any], np.ndarray]):
         if not np.all(np.isfinite(act)):
             raise ValueError(f"action must be finite, got {act}")
         act = np.clip(act, self._act_low, self._act_high)
-        world, task = self.world, self.task
+        world = self.world
         self._needs_reset = True  # until the step completes: a SimulationError leaves it set
         world.step(world.robot.ctrl(act[:7], float(act[7])))  # SimulationError propagates
-        task.on_step(world)
         self._needs_reset = False
         self._elapsed += 1
-        info = copy.deepcopy(dict(task.evaluate(world)))
+        info = copy.deepcopy(progress.update(world))  # the task's on_step, then its evaluate
         success = bool(info["success"])
-        self._streak = self._streak + 1 if success else 0
-        terminated = self._streak >= self.hold_steps
+        terminated = progress.finished
         truncated = self._elapsed >= self.max_steps
         info["is_success"] = terminated
         return self._observation(), 1.0 if success else 0.0, terminated, truncated, info

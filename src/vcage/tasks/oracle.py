@@ -3,7 +3,7 @@
 It is the one judge that reads the simulator, by design: every episode is audited by it, so the
 label noise of the critics can be measured, and atomic tasks declare their success in the same
 predicates. Events (``pressed``) are latched while the subtask runs; every state predicate must hold
-on the final state for consecutive control steps (the caller holds, see :func:`.success.held`).
+on the final state for consecutive control steps (the caller holds, see :func:`.engine.held`).
 """
 
 from __future__ import annotations

@@ -8,7 +8,6 @@ from typing import Any
 import numpy as np
 
 from vcage.config import Randomization, SimConfig
-from vcage.errors import SkillError
 from vcage.scene.instantiate import Instantiator, SceneConfig
 from vcage.scene.placement import PlacementStats
 from vcage.scene.spec import SceneSpec
@@ -17,7 +16,7 @@ from vcage.skills.base import Skills
 from vcage.skills.playback import Recording
 from vcage.skills.reachability import reach_map
 from vcage.tasks.base import TASKS, AtomicTask
-from vcage.tasks.success import held
+from vcage.tasks.engine import Step, TaskGoal, run
 
 
 @dataclass
@@ -82,13 +81,7 @@ def run_episode(name: str, seed: int, rand: Randomization | None = None,
     initial = world.get_state()
     skills = Skills(world)
     skills.player.record = record
-    skills.player.hooks.append(task.on_step)
-    error = None
-    try:
-        task.expert(skills)
-    except SkillError as exc:
-        error = str(exc)
-    holds, info = held(skills, lambda: task.evaluate(skills.world), task.hold_steps)
+    outcome = run(skills, [Step(name, instruction, task.expert, TaskGoal(task, world))]).outcomes[0]
     assert task.spec is not None
-    return EpisodeResult(name, seed, holds["success"] and error is None, instruction, info, task.spec,
-                         skills.player.recording, initial, world, error)
+    return EpisodeResult(name, seed, outcome.oracle_success, instruction, outcome.values, task.spec,
+                         skills.player.recording, initial, world, outcome.skill_error)

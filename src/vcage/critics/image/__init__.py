@@ -1,6 +1,6 @@
 """The offline image critic: judges a subtask from rendered images and segmentation masks only.
 
-It sees what :mod:`vcage.pipeline.verifier` renders around the subtask: the orthographic top view
+It sees what :mod:`vcage.tasks.verifier` renders around the subtask: the orthographic top view
 (RGB and the renderer's segmentation masks, with its pixel size in metres) and the perspective front
 view (RGB, segmentation and depth), before the subtask, at its deepest moment (where the hand was
 lowest in the subtask's own motion, not in what ran after it) and after the retreat. It never reads
