@@ -11,13 +11,16 @@ software's versions, whose shape may change).
     .venv/bin/python benchmarks/same_data.py --before HEAD --after HEAD \
         --after-python .venv-latest/bin/python      # the locked versions against the newest (check-latest.sh)
 
-Prints one line per compared file and a summary; exits 1 if any file differs.
+Prints one line per compared file and a summary; exits 1 if any file differs. Under a file that
+differs it says where: the fields (as paths, list positions as ``[]``) of the attempt log's lines, the
+columns of a parquet table, that differ.
 """
 
 from __future__ import annotations
 
 import argparse
 import filecmp
+import json
 import os
 import subprocess
 import sys
@@ -68,9 +71,44 @@ def compare(a: Path, b: Path) -> tuple[int, int]:
         for rel in files:
             same = (b / name / rel).is_file() and filecmp.cmp(a / name / rel, b / name / rel, shallow=False)
             print(f"{'same' if same else 'DIFF'} {name}/{rel}")
+            if not same and (b / name / rel).is_file():
+                print(f"    {explain(a / name / rel, b / name / rel)}")
             compared += 1
             differ += not same
     return compared, differ
+
+
+def explain(a: Path, b: Path) -> str:
+    """Where two versions of a file differ: fields of JSON lines, columns of a parquet table."""
+    if a.suffix == ".jsonl":
+        lines_a, lines_b = a.read_text().splitlines(), b.read_text().splitlines()
+        if len(lines_a) != len(lines_b):
+            return f"{len(lines_a)} lines against {len(lines_b)}"
+        paths: set[str] = set()
+        for x, y in zip(lines_a, lines_b, strict=True):
+            paths |= _differing(json.loads(x), json.loads(y), "")
+        return "fields differ: " + ", ".join(sorted(paths))
+    if a.suffix == ".parquet":
+        import pyarrow.parquet as pq
+
+        ta, tb = pq.read_table(a), pq.read_table(b)
+        if ta.schema != tb.schema or ta.num_rows != tb.num_rows:
+            return (f"tables differ in shape: {ta.schema.names} x {ta.num_rows} against "
+                    f"{tb.schema.names} x {tb.num_rows}")
+        columns = [c for c in ta.schema.names if not ta.column(c).equals(tb.column(c))]
+        return "columns differ: " + ", ".join(columns) if columns else "same values, different bytes"
+    return "bytes differ"
+
+
+def _differing(x: object, y: object, path: str) -> set[str]:
+    if isinstance(x, dict) and isinstance(y, dict):
+        out: set[str] = set()
+        for key in set(x) | set(y):
+            out |= _differing(x.get(key), y.get(key), f"{path}.{key}" if path else str(key))
+        return out
+    if isinstance(x, list) and isinstance(y, list) and len(x) == len(y):
+        return set().union(*(_differing(i, j, f"{path}[]") for i, j in zip(x, y, strict=True)))
+    return set() if x == y else {path}
 
 
 def main() -> None:

@@ -90,6 +90,28 @@ def test_generate_from_a_synthesized_scene(scene_dir: Path, tmp_path: Path) -> N
             assert abs(o["xy"][1] - placed["y"]) <= rand.object_xy.high + 1e-6
 
 
+def test_a_job_grounds_the_plan_on_the_scene_its_configuration_holds(scene_dir: Path, tmp_path: Path) -> None:
+    """Found on 2026-12-08: the CLI grounded the plan on a synthesized scene, the pipeline did not, so
+    ``generate()`` given a configuration with a scene and no plan wrote an ungrounded plan."""
+    from vcage.pipeline.generate import generate
+    from vcage.pipeline.job import SceneSource, build_job
+
+    scene = load_scene(scene_dir)
+    grounded, _ = ground_plan(OfflinePlanner().plan(INSTRUCTION), scene)
+    given = build_job(GenerateConfig(), INSTRUCTION, SceneSource(scene_file=scene_dir / "scene.json"))
+    held = build_job(GenerateConfig(synthesized=scene), INSTRUCTION)  # e.g. a dataset's stored configuration
+    assert given.plan == held.plan == grounded and given.cfg.synthesized == held.cfg.synthesized
+    cfg = replace(GenerateConfig(synthesized=scene, seed=0), render=replace(GenerateConfig().render, size=(64, 64)))
+    generate(INSTRUCTION, 1, tmp_path / "api", cfg)
+    stored = DatasetReader(tmp_path / "api").config or {}
+    assert stored["plan"] == grounded.model_dump(mode="json")
+    for source, message in ((SceneSource(synthesize=PROMPT, scene_file=scene_dir), "give no --scene"),
+                            (SceneSource(subtasks=tmp_path / "db.sqlite"), "give no INSTRUCTION"),
+                            (SceneSource(), None)):
+        with pytest.raises(ConfigError, match=message or "give an INSTRUCTION"):
+            build_job(GenerateConfig(), INSTRUCTION if message else None, source)
+
+
 def test_bad_scenes_are_typed_errors(scene_dir: Path, tmp_path: Path) -> None:
     bad = tmp_path / "bad.json"
     bad.write_text('{"kind": "something else"}')

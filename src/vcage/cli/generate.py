@@ -18,7 +18,6 @@ from vcage.errors import BackendError, ConfigError
 
 if TYPE_CHECKING:
     from vcage.pipeline.config import GenerateConfig
-    from vcage.planning.schema import Plan
 
 
 @app.command("generate")
@@ -85,7 +84,7 @@ def generate_cmd(
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
     from vcage.pipeline.generate import generate
-    from vcage.planning import make_planner
+    from vcage.pipeline.job import SceneSource, build_job
 
     cfg = build_config(config, mode, {
         ("planner", "name"): planner, ("critic", "name"): critic, ("critic", "votes"): votes,
@@ -102,23 +101,8 @@ def generate_cmd(
                                  "preflight": critic_preflight})})
     cfg = cfg.resolved()
     warn_if_oversubscribed(cfg.executor.name, cfg.executor.workers)
-    if subtasks is not None or cfg.chain is not None:
-        if instruction is not None or scene is not None or synthesize is not None:
-            raise ConfigError("--subtasks composes its own plan and scene: give no INSTRUCTION, no "
-                              "--scene and no --synthesize")
-        plan, cfg = on_subtask_chain(cfg, subtasks, chain, subtask_scene)
-        instruction = plan.instruction
-    elif instruction is None:
-        raise ConfigError("give an INSTRUCTION (e.g. 'get ready for work'), or --subtasks DB to run a chain "
-                          "of verified subtasks")
-    else:
-        plan = make_planner(cfg.planner).plan(instruction)  # before any progress is shown
-        if synthesize is not None or cfg.synthesis is not None:
-            if scene is not None:
-                raise ConfigError("--synthesize makes a new scene for every attempt: give no --scene")
-            plan, cfg = on_scene_per_attempt(plan, cfg, synthesize)
-        elif scene is not None or cfg.synthesized is not None:
-            plan, cfg = on_synthesized_scene(plan, cfg, scene)
+    built = build_job(cfg, instruction, SceneSource(scene, synthesize, subtasks, chain, subtask_scene))
+    instruction, plan, cfg = built.instruction, built.plan, built.cfg  # planned before any progress shows
     bar = Progress(TextColumn("{task.description}"), BarColumn(),
                    TextColumn("{task.completed}/{task.total}"), TimeElapsedColumn(), console=console)
     job = None
@@ -208,52 +192,6 @@ def build_config(path: Path | None, mode: str, options: dict[tuple[str, ...], An
             else:
                 tree[part]["backend"] = BackendConfig.from_env(prefix, None, **given).to_dict()
     return GenerateConfig.from_dict(tree)
-
-
-def on_synthesized_scene(plan: Plan, cfg: GenerateConfig, path: Path | None) -> tuple[Plan, GenerateConfig]:
-    """The plan bound to the synthesized scene in ``path`` (else the one ``cfg`` already holds, e.g.
-    from a dataset's meta/vcage.json), and ``cfg`` recording that scene."""
-    from dataclasses import replace
-
-    from vcage.synthesis.scene_file import ground_plan, load_scene
-
-    synthesized = load_scene(path) if path is not None else cfg.synthesized
-    assert synthesized is not None
-    plan, synthesized = ground_plan(plan, synthesized)
-    return plan, replace(cfg, synthesized=synthesized)
-
-
-def on_scene_per_attempt(plan: Plan, cfg: GenerateConfig, prompt: str | None) -> tuple[Plan, GenerateConfig]:
-    """The plan grounded on the scene synthesized from ``prompt`` (else from the prompt ``cfg``
-    already holds) for the run seed, and ``cfg`` asking for a new scene for every attempt."""
-    from dataclasses import replace
-
-    from vcage.synthesis.driver import synthesized_scene
-    from vcage.synthesis.scene_file import SynthesisRequest, ground_plan
-
-    request = SynthesisRequest(prompt) if prompt is not None else cfg.synthesis
-    assert request is not None
-    plan, _ = ground_plan(plan, synthesized_scene(request, cfg.seed))
-    return plan, replace(cfg, synthesis=request, synthesized=None)
-
-
-def on_subtask_chain(cfg: GenerateConfig, db: Path | None, length: int,
-                     scene_id: str | None) -> tuple[Plan, GenerateConfig]:
-    """A chain of ``length`` verified subtasks of the database ``db`` drawn with the run seed (else
-    the chain ``cfg`` already records, rebuilt from its ids), and ``cfg`` recording it and its scene."""
-    from dataclasses import replace
-
-    from vcage.subtasks.chains import compose, rebuild
-    from vcage.subtasks.store import SubtaskStore
-
-    if db is not None:
-        with SubtaskStore(db, readonly=True) as store:
-            composed = compose(store, length, cfg.seed, scene_id)
-    else:
-        assert cfg.chain is not None
-        with SubtaskStore(cfg.chain.db, readonly=True) as store:
-            composed = rebuild(store, cfg.chain)
-    return composed.plan, replace(cfg, synthesized=composed.scene, chain=composed.provenance, synthesis=None)
 
 
 def cores_available() -> int:

@@ -29,9 +29,9 @@ from vcage.pipeline.config import GenerateConfig
 from vcage.pipeline.episode import Timing
 from vcage.pipeline.executors import make_executor
 from vcage.pipeline.features import dataset_features
+from vcage.pipeline.job import build_job
 from vcage.pipeline.sampling import EpisodeRun, build_critic, camera_key
 from vcage.pipeline.stage import Stage
-from vcage.planning import make_planner
 from vcage.planning.schema import Plan
 from vcage.provenance import software
 
@@ -91,7 +91,9 @@ def generate(instruction: str, episodes: int, out: Path | str, cfg: GenerateConf
     ``cfg.executor`` runs up to ``cfg.executor.workers`` episodes at once (see
     :mod:`vcage.pipeline.executors`). Each episode's attempts depend only on its seeds, so the
     dataset is the same for any executor and number of workers. The resolved configuration
-    (model endpoints included, keys never) is stored with the dataset and every episode.
+    (model endpoints included, keys never) is stored with the dataset and every episode. Without
+    ``plan``, the instruction is planned and grounded on ``cfg``'s scene source
+    (:func:`~vcage.pipeline.job.build_job`).
     """
     if isinstance(episodes, bool) or not isinstance(episodes, int) or episodes < (0 if total else 1):
         raise ConfigError(f"episodes must be an integer >= {0 if total else 1}, got {episodes!r}")
@@ -99,7 +101,9 @@ def generate(instruction: str, episodes: int, out: Path | str, cfg: GenerateConf
     cfg = cfg.resolved()
     pool = make_executor(cfg.executor)  # checks the arguments before any work
     t0 = time.perf_counter()
-    plan = plan or make_planner(cfg.planner).plan(instruction)
+    if plan is None:  # the plan of the instruction on the configuration's scene source
+        job = build_job(cfg, instruction)
+        plan, cfg = job.plan, job.cfg
     planning = time.perf_counter() - t0
     critic = build_critic(cfg)  # a misconfigured critic (e.g. no API key) fails here, before any work
     if critic is not None:
