@@ -1,7 +1,8 @@
 """The documentation cannot rot: the site builds with warnings as errors (and a broken link fails it),
 the command-line reference is read from the commands themselves, every figure on the results page
 names its command and commit, and every ``vcage`` command line in the README's and the guides'
-shell blocks parses against the real command line (options that exist, values of the right type).
+shell blocks parses against the real command line (options that exist, values of the right type),
+and the architecture's diagram of the packages and their imports is the code's.
 The README's "make your own dataset" block runs for real, at smaller sizes (slow)."""
 
 from __future__ import annotations
@@ -23,6 +24,7 @@ sys.path.insert(0, str(ROOT / "scripts"))
 sys.path.insert(0, str(ROOT / "benchmarks"))
 
 import docs_hooks  # noqa: E402, I001 - from scripts/ and benchmarks/, put on the path above
+import package_diagram  # noqa: E402
 import results  # noqa: E402
 
 MKDOCS = Path(sys.executable).parent / "mkdocs"
@@ -202,3 +204,21 @@ def test_the_readme_example_runs(tmp_path: Path) -> None:
         assert done.returncode == 0, (line, done.stdout[-2000:], done.stderr[-2000:])
         ran += 1
     assert ran == 4 and (tmp_path / "mouse.html").stat().st_size > 10_000
+
+
+def test_the_package_diagram_of_the_architecture_is_the_codes() -> None:
+    stale = package_diagram.check(ROOT / "docs" / "ARCHITECTURE.md")
+    assert stale is None, stale
+
+
+def test_a_stale_package_diagram_is_caught(tmp_path: Path) -> None:
+    page = tmp_path / "ARCHITECTURE.md"
+    fresh = package_diagram.diagram()
+    edge = next(line for line in fresh.splitlines() if " --> " in line)
+    missing = fresh.replace(f"{edge}\n", "")  # the diagram less one edge
+    page.write_text(f"# A\n\n{package_diagram.START}\n{missing}\n{package_diagram.END}\n")
+    stale = package_diagram.check(page)
+    assert stale is not None and f"+ {edge.strip()}" in stale and "--write docs/ARCHITECTURE.md" in stale
+    assert package_diagram.main(["--check", str(page)]) == 1
+    package_diagram.main(["--write", str(page)])
+    assert package_diagram.check(page) is None and page.read_text().startswith("# A\n\n")
