@@ -18,7 +18,6 @@ import numpy as np
 
 from vcage.backends import BackendConfig
 from vcage.config import from_fields
-from vcage.critics.image.thresholds import overridden, values
 from vcage.errors import ConfigError
 from vcage.planning.schema import Subtask
 from vcage.registry import Registry
@@ -146,10 +145,12 @@ class CriticConfig:
         CRITICS.get(self.name)  # an unknown name lists the valid ones
         if not isinstance(self.thresholds, Mapping):
             raise ConfigError(f"critic thresholds must map names to values, got {self.thresholds!r}")
-        if self.thresholds and self.name != "image":
-            raise ConfigError(f"critic thresholds apply to the image critic, not to {self.name!r}")
-        given = values(overridden(self.thresholds))  # refuses an unknown name or a value not of its kind
-        object.__setattr__(self, "thresholds", {name: given[name] for name in self.thresholds})
+        if self.thresholds:
+            if self.name not in THRESHOLDS:
+                raise ConfigError(f"critic thresholds apply to the {', '.join(THRESHOLDS.names())} critic, "
+                                  f"not to {self.name!r}")
+            given = THRESHOLDS.get(self.name)(self.thresholds)  # refuses an unknown name or a wrong kind
+            object.__setattr__(self, "thresholds", {name: given[name] for name in self.thresholds})
         if isinstance(self.votes, bool) or not isinstance(self.votes, int) or self.votes < 1:
             raise ConfigError(f"critic votes must be an integer >= 1, got {self.votes!r}")
         if self.rule not in ("majority", "all"):
@@ -172,6 +173,10 @@ class CriticConfig:
 
 CriticFactory = Callable[[CriticConfig], Critic]
 CRITICS: Registry[CriticFactory] = Registry("critic")
+# The critics that take thresholds: each checks the overrides given by name and returns their values,
+# as they are stored (a ConfigError for an unknown name or a value not of its kind).
+ThresholdCheck = Callable[[Mapping[str, Any]], dict[str, Any]]
+THRESHOLDS: Registry[ThresholdCheck] = Registry("critic with thresholds")
 
 
 def make_critic(config: CriticConfig) -> Critic:

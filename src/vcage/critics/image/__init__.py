@@ -90,7 +90,7 @@ from pathlib import Path
 from typing import Any
 
 from vcage.critics import masks
-from vcage.critics.base import CRITICS, Critic, CriticConfig, Observation, Reason, Verdict
+from vcage.critics.base import CRITICS, THRESHOLDS, Critic, CriticConfig, Observation, Reason, Verdict
 from vcage.critics.image import thresholds
 from vcage.critics.image.drawers import _closed, _opened
 from vcage.critics.image.pose import _facing, _hanging, _lifted, _near, _on_table, _side, _upright
@@ -171,6 +171,11 @@ for _name, _check in _checks.items():
 @CRITICS.register("image")
 def _image(config: CriticConfig) -> Critic:
     return ImageCritic(config.thresholds)
+
+
+@THRESHOLDS.register("image")
+def _image_thresholds(given: Mapping[str, Any]) -> dict[str, Any]:
+    return thresholds.values(thresholds.overridden(given))
 
 
 _DIGEST = functools.cache(rules_digest)
