@@ -101,7 +101,8 @@ def test_a_job_grounds_the_plan_on_the_scene_its_configuration_holds(scene_dir: 
     given = build_job(GenerateConfig(), INSTRUCTION, SceneSource(scene_file=scene_dir / "scene.json"))
     held = build_job(GenerateConfig(synthesized=scene), INSTRUCTION)  # e.g. a dataset's stored configuration
     assert given.plan == held.plan == grounded and given.cfg.synthesized == held.cfg.synthesized
-    cfg = replace(GenerateConfig(synthesized=scene, seed=0), render=replace(GenerateConfig().render, size=(64, 64)))
+    cfg = replace(GenerateConfig(synthesized=scene, seed=0),
+                  render=replace(GenerateConfig().render, size=(64, 64)))
     generate(INSTRUCTION, 1, tmp_path / "api", cfg)
     stored = DatasetReader(tmp_path / "api").config or {}
     assert stored["plan"] == grounded.model_dump(mode="json")
