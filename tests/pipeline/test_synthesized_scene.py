@@ -106,6 +106,9 @@ def test_a_job_grounds_the_plan_on_the_scene_its_configuration_holds(scene_dir: 
     generate(INSTRUCTION, 1, tmp_path / "api", cfg)
     stored = DatasetReader(tmp_path / "api").config or {}
     assert stored["plan"] == grounded.model_dump(mode="json")
+    assert (GenerateConfig().scene_source, held.cfg.scene_source) == ("layout", "scene")
+    with pytest.raises(ConfigError, match="one scene source; drop 'synthesis' or 'synthesized'"):
+        GenerateConfig.from_dict({"synthesized": scene.to_dict(), "synthesis": {"prompt": PROMPT}})
     for source, message in ((SceneSource(synthesize=PROMPT, scene_file=scene_dir), "give no --scene"),
                             (SceneSource(subtasks=tmp_path / "db.sqlite"), "give no INSTRUCTION"),
                             (SceneSource(), None)):

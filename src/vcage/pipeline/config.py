@@ -91,6 +91,22 @@ class GenerateConfig:
         attempts = self.max_attempts
         if isinstance(attempts, bool) or not isinstance(attempts, int) or attempts < 1:
             raise ConfigError(f"max_attempts must be an integer >= 1, got {attempts!r}")
+        if self.synthesis is not None and (self.synthesized is not None or self.chain is not None):
+            given = "a synthesized scene" if self.synthesized is not None else "a subtask chain"
+            raise ConfigError(f"the configuration asks for a scene synthesized per attempt and {given}: "
+                              "one scene source; drop 'synthesis' or "
+                              f"'{'synthesized' if self.synthesized is not None else 'chain'}'")
+
+    @property
+    def scene_source(self) -> str:
+        """Where each attempt's scene comes from: ``layout`` (the plan's objects placed afresh),
+        ``scene`` (a synthesized scene), ``synthesis`` (a scene synthesized for every attempt) or
+        ``chain`` (a chain of verified subtasks, which brings its scene); :mod:`.job` resolves it."""
+        if self.synthesis is not None:
+            return "synthesis"
+        if self.chain is not None:
+            return "chain"
+        return "scene" if self.synthesized is not None else "layout"
 
     @classmethod
     def vanilla(cls, **fields: Any) -> GenerateConfig:

@@ -3,7 +3,8 @@
 The scene source is one choice: the plan's own layout (the default: the planner's plan laid out in
 the work area), a synthesized scene file (``GenerateConfig.synthesized``), a prompt synthesized into
 a new scene for every attempt (``synthesis``), or a chain of verified subtasks from a subtask
-database (``chain``: its plan and its scene). :func:`build_job` resolves the choice once, from the
+database (``chain``: its plan and its scene); ``GenerateConfig.scene_source`` names it, and the
+configuration refuses two at once. :func:`build_job` resolves the choice once, from the
 configuration and what a caller adds on top of it (:class:`SceneSource`: the command line's
 ``--scene``, ``--synthesize``, ``--subtasks``), grounds the plan on the scene, and returns the
 configuration that records the choice, so that a dataset's stored configuration rebuilds the same
@@ -42,7 +43,7 @@ class Job:
 def build_job(cfg: GenerateConfig, instruction: str | None, source: SceneSource = SceneSource()) -> Job:
     """The plan of ``instruction`` (or of a subtask chain) grounded on its scene source; a
     :class:`ConfigError` when the sources given contradict each other or none names a task."""
-    if source.subtasks is not None or cfg.chain is not None:
+    if source.subtasks is not None or cfg.scene_source == "chain":
         if instruction is not None or source.scene_file is not None or source.synthesize is not None:
             raise ConfigError("--subtasks composes its own plan and scene: give no INSTRUCTION, no "
                               "--scene and no --synthesize")
@@ -52,11 +53,11 @@ def build_job(cfg: GenerateConfig, instruction: str | None, source: SceneSource 
         raise ConfigError("give an INSTRUCTION (e.g. 'get ready for work'), or --subtasks DB to run a chain "
                           "of verified subtasks")
     plan = make_planner(cfg.planner).plan(instruction)
-    if source.synthesize is not None or cfg.synthesis is not None:
+    if source.synthesize is not None or cfg.scene_source == "synthesis":
         if source.scene_file is not None:
             raise ConfigError("--synthesize makes a new scene for every attempt: give no --scene")
         plan, cfg = _scene_per_attempt(plan, cfg, source.synthesize)
-    elif source.scene_file is not None or cfg.synthesized is not None:
+    elif source.scene_file is not None or cfg.scene_source == "scene":
         plan, cfg = _synthesized_scene(plan, cfg, source.scene_file)
     return Job(instruction, plan, cfg)
 
