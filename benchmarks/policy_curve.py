@@ -44,7 +44,7 @@ def main() -> None:
     from vcage.cli.evaluate import read_scenes
     from vcage.data import DatasetReader
     from vcage.pipeline.evaluation import make_env
-    from vcage.policy.checkpoint import checkpoints, load_checkpoint
+    from vcage.policy.checkpoint import NAME, checkpoints, load_checkpoint
     from vcage.policy.evaluate import evaluate, training_scenes
 
     if args.training_scenes and args.scenes:
@@ -60,7 +60,10 @@ def main() -> None:
         if not found:
             raise SystemExit(f"{run} holds no checkpoint: pass a vcage train --out directory")
         chosen = found[::args.every] + ([found[-1]] if (len(found) - 1) % args.every else [])
-        scenes = training_scenes(load_checkpoint(found[0]), args.episodes) if args.training_scenes else given
+        # a run's batch and dataset are those of its first checkpoint (resuming changes only the steps)
+        first = load_checkpoint(found[0])
+        per_step = int(first["config"]["batch_size"]) / int(first["dataset"]["frames"])
+        scenes = training_scenes(first, args.episodes) if args.training_scenes else given
         episodes = min(args.episodes, len(scenes)) if scenes else args.episodes
         factory = functools.partial(make_env, scenes=scenes) if scenes else None
         tag = re.sub(r"[^A-Za-z0-9]+", "-", f"{name}-n{episodes}-s{args.seed}-b{args.batch}")
@@ -69,9 +72,10 @@ def main() -> None:
             record = cached_evaluation(cache, functools.partial(
                 evaluate, path, episodes, seed=args.seed, env_config=env_config, threads=1, make_env=factory,
                 workers=args.workers, batch=args.batch))
-            payload = load_checkpoint(path)
-            step = int(payload["step"])
-            passes[step] = step * int(payload["config"]["batch_size"]) / int(payload["dataset"]["frames"])
+            named = NAME.match(path.name)
+            assert named is not None  # checkpoints() lists only the files its pattern names
+            step = int(named.group(1))
+            passes[step] = step * per_step
             table.setdefault(step, {})[index] = (int(record["successes"]), int(record["episodes"]))
             print(f"{run.name}: step {step} {record['successes']}/{record['episodes']}", flush=True)
     print(f"\n{'step':>7s} {'passes':>7s} " + " ".join(f"{r.name[-12:]:>12s}" for r in args.runs)
