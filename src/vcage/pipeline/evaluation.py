@@ -56,6 +56,7 @@ from vcage.pipeline.features import (
     observe,
 )
 from vcage.pipeline.plan_layout import episode_scene, plan_layout
+from vcage.pipeline.rollout import plan_goals
 from vcage.planning.schema import Plan
 from vcage.scene.instantiate import Instantiator
 from vcage.scene.spec import ROBOT_MOUNT
@@ -65,7 +66,7 @@ from vcage.sim.world import World
 from vcage.skills.ik import IKSolver
 from vcage.skills.reachability import reach_map
 from vcage.synthesis.errors import SynthesisError
-from vcage.tasks.engine import PredicateGoal, Progress
+from vcage.tasks.engine import Progress
 from vcage.tasks.oracle import Oracle
 from vcage.vocabulary import PREDICATES, Kind
 
@@ -230,8 +231,7 @@ class GoalEnv(gym.Env[dict[str, np.ndarray], np.ndarray]):
         self.world, self.scene_seed = world, scene_seed
         self._steps = 0
         self._arm_target = world.robot.arm_q(world.data)
-        self._progress = Progress([PredicateGoal(self._oracle, world, tuple(sub.predicates))
-                                   for sub in self.plan.subtasks], start=subtask)
+        self._progress = Progress(plan_goals(world, self.plan, self._oracle), start=subtask)
         return observe(world, self.plan), self._info()
 
     def _start_subtask(self, options: dict[str, Any]) -> int:

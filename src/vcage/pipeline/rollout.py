@@ -9,7 +9,7 @@ the rollout.
 
 from __future__ import annotations
 
-from typing import Any
+from collections.abc import Callable
 
 from vcage.planning.schema import Plan, Subtask
 from vcage.sim.world import World
@@ -17,14 +17,19 @@ from vcage.skills.base import Skills
 from vcage.tasks.engine import PredicateGoal, Rollout, Step, StepVerifier, run
 from vcage.tasks.oracle import Oracle
 
-__all__ = ["Rollout", "plan_steps", "run_plan"]
+__all__ = ["Rollout", "plan_goals", "plan_steps", "run_plan"]
 
 
-def plan_steps(world: World, plan: Plan, oracle: Oracle | None = None) -> list[Step]:
+def plan_goals(world: World, plan: Plan, oracle: Oracle) -> list[PredicateGoal]:
+    """Each subtask's goal: its predicates, read by ``oracle`` (one per episode, so that events latch
+    while their subtask is the current one). The expert's steps and a policy's progress share them."""
+    return [PredicateGoal(oracle, world, tuple(sub.predicates)) for sub in plan.subtasks]
+
+
+def plan_steps(world: World, plan: Plan) -> list[Step]:
     """The engine's steps of ``plan`` on ``world``: each subtask's skill call, then a retreat."""
-    oracle = oracle or Oracle()
-    return [Step(sub.skill, sub.description, _acts(sub), PredicateGoal(oracle, world, tuple(sub.predicates)))
-            for sub in plan.subtasks]
+    return [Step(sub.skill, sub.description, _acts(sub), goal)
+            for sub, goal in zip(plan.subtasks, plan_goals(world, plan, Oracle()), strict=True)]
 
 
 def run_plan(world: World, plan: Plan, skills: Skills | None = None,
@@ -33,7 +38,7 @@ def run_plan(world: World, plan: Plan, skills: Skills | None = None,
     return run(skills or Skills(world), plan_steps(world, plan), verifier)
 
 
-def _acts(sub: Subtask) -> Any:
+def _acts(sub: Subtask) -> Callable[[Skills], None]:
     args = dict(sub.args)
     if isinstance(args.get("xy"), list):
         args["xy"] = tuple(args["xy"])
