@@ -92,6 +92,15 @@ def test_steps_run_in_order_each_held_and_judged(world: World) -> None:
     assert not rollout.oracle_success or all(o.oracle_success for o in rollout.outcomes)
 
 
+def test_goals_stop_watching_when_the_program_ends(world: World) -> None:
+    skills = Skills(world, Player(world))
+    goal = Scripted([True])
+    run(skills, [step(goal)])
+    told = goal.steps
+    skills.player.wait(0.1)  # the skills act on after the program (e.g. another program)
+    assert goal.steps == told and skills.player.hooks == []
+
+
 def test_a_goal_met_too_late_in_the_hold_is_not_reached(world: World) -> None:
     goal = Scripted([False] * (HOLD + 1) + [True])
     rollout = run(Skills(world, Player(world)), [step(goal)])

@@ -143,7 +143,20 @@ def run(skills: Skills, steps: Sequence[Step], verifier: StepVerifier | None = N
     :class:`SimulationError` propagates: an unstable rollout is not an outcome.
     """
     current: list[Goal] = []
-    skills.player.hooks.append(lambda world: current[0].on_step(world) if current else None)
+
+    def on_step(world: World) -> None:  # the current step's goal is told of every control step
+        if current:
+            current[0].on_step(world)
+
+    skills.player.hooks.append(on_step)
+    try:
+        return _run(skills, steps, verifier, judge_unmet, current)
+    finally:  # the skills may act on after the program: its goals no longer watch
+        skills.player.hooks.remove(on_step)
+
+
+def _run(skills: Skills, steps: Sequence[Step], verifier: StepVerifier | None, judge_unmet: bool,
+         current: list[Goal]) -> Rollout:
     recording = skills.player.recording
     rollout = Rollout()
     for i, step in enumerate(steps):
