@@ -229,13 +229,14 @@ def evaluate(args: argparse.Namespace) -> dict[str, Any]:
     from vcage.cli.evaluate import read_scenes
     from vcage.data import DatasetReader
     from vcage.pipeline.evaluation import make_env
+    from vcage.policy.evaluate import dataset_scenes
     from vcage.policy.metrics import wilson_interval
 
     checkpoint = resolve_checkpoint(args.checkpoint)
     reader = DatasetReader(args.dataset)
     assert reader.config is not None, f"{args.dataset} is not a vcage dataset (no meta/vcage.json config)"
     if args.training_scenes:
-        scenes = [int(reader.extras(i)["seed"]) for i in range(min(args.episodes, reader.num_episodes))]
+        scenes = dataset_scenes(args.dataset, args.episodes)
         where = "training scenes"
     else:
         if args.scenes is None:

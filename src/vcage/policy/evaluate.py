@@ -145,10 +145,15 @@ def training_scenes(checkpoint: Mapping[str, Any], count: int) -> list[int]:
     """The scene seeds of the first ``count`` episodes of the dataset ``checkpoint`` was trained on
     (all of them if it has fewer): rolling out on them asks whether the policy reproduces its own
     demonstrations, which tells a policy that cannot fit its data from one that does not generalise."""
+    return dataset_scenes(checkpoint["dataset"]["path"], count)
+
+
+def dataset_scenes(path: str | Path, count: int) -> list[int]:
+    """The scene seeds of the first ``count`` episodes of the vcage dataset at ``path`` (all of them
+    if it has fewer); PolicyError if it cannot be read or does not store them."""
     from vcage.data.reader import DatasetReader
     from vcage.errors import DatasetError
 
-    path = checkpoint["dataset"]["path"]
     try:
         reader = DatasetReader(path)
         seeds = [reader.extras(i).get("seed") for i in range(min(count, reader.num_episodes))]
